@@ -1,0 +1,33 @@
+// The HDR film: linear radiance in single-precision floating point, row-major from the top-left
+// pixel. Whatever precision the renderer traced in, images are kept in float to the end.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include <cassert>
+#include <cstddef>
+#include <vector>
+
+namespace prism {
+
+struct Image {
+    int width = 0;
+    int height = 0;
+    std::vector<glm::vec3> pixels;
+
+    Image() = default;
+    Image(int width_, int height_)
+        : width(width_), height(height_),
+          pixels(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_), glm::vec3(0.0f)) {}
+
+    glm::vec3& operator()(int x, int y) {
+        assert(x >= 0 && x < width && y >= 0 && y < height);
+        return pixels[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)];
+    }
+    const glm::vec3& operator()(int x, int y) const {
+        assert(x >= 0 && x < width && y >= 0 && y < height);
+        return pixels[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)];
+    }
+};
+
+}  // namespace prism
