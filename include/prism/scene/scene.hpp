@@ -122,6 +122,10 @@ struct Scene {
     std::vector<Sphere> spheres;
     std::vector<Plane> planes;
     std::vector<MeshInstance> mesh_instances;
+
+    // Elements of the file that this version does not render (e.g. "AreaLight"), one entry per
+    // distinct name, so that the renderer can say what it leaves out instead of hiding it.
+    std::vector<std::string> unsupported;
 };
 
 }  // namespace prism::scene
