@@ -1,10 +1,20 @@
-// PLACEHOLDER for the scene-level entry point: renders every camera of a plain scene description
-// with a renderer configuration chosen from the scene. The interface is fixed; the body is not.
+// The scene-level entry point: picks the renderer configuration a scene needs ("model no more
+// than a scene needs"), builds it once, and renders every camera. The CLI, the scene suite and
+// the tests all come through here, so there is one way from a scene description to images.
 #pragma once
 
 #include <prism/image/image.hpp>
+#include <prism/render/renderer.hpp>
 #include <prism/scene/scene.hpp>
 
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <ostream>
 #include <stdexcept>
@@ -15,11 +25,21 @@ namespace prism {
 
 enum class Precision { single, double_refine, double_all };
 
+inline const char* to_string(Precision precision) {
+    switch (precision) {
+        case Precision::single: return "float";
+        case Precision::double_refine: return "double-refine";
+        case Precision::double_all: return "double";
+    }
+    return "?";
+}
+
 struct RenderOptions {
     int threads = 0;                      // 0: all hardware threads
     std::optional<Precision> precision;   // empty: chosen from the scene
     double resolution_scale = 1.0;        // < 1 renders a reduced image (suite, quick checks)
     bool progress = false;                // progress bar on stderr
+    bool cull_backfaces = false;          // primary rays skip triangles facing away
 };
 
 struct CameraImage {
@@ -29,8 +49,70 @@ struct CameraImage {
     double seconds = 0.0;     // render time of this camera (excludes loading and BVH build)
 };
 
-inline std::vector<CameraImage> render_scene(const scene::Scene&, const RenderOptions&, std::ostream& /*log*/) {
-    throw std::logic_error("render_scene not implemented yet");
+// The configuration chosen for a scene, with the reason, for the CLI to print.
+struct Choice {
+    Precision precision = Precision::single;
+    std::string reason;
+};
+
+inline Choice choose_precision(const scene::Scene&, const RenderOptions& options) {
+    if (options.precision) return {*options.precision, "requested with --precision"};
+    return {Precision::single, "default: float traversal with watertight triangle tests"};
+}
+
+namespace detail {
+
+inline int scaled(int size, double scale) { return std::max(1, int(std::lround(size * scale))); }
+
+template <class C>
+std::vector<CameraImage> render_with(const scene::Scene& scene, const RenderOptions& options, std::ostream& log,
+                                     const std::function<void(std::size_t camera, int pixels)>& on_tile) {
+    using Clock = std::chrono::steady_clock;
+    const auto build_start = Clock::now();
+    const Renderer<C> renderer(scene, options.cull_backfaces);
+    const double build_seconds = std::chrono::duration<double>(Clock::now() - build_start).count();
+    log << "built " << renderer.geometry().instance_count() << " instances, " << renderer.geometry().triangle_count()
+        << " triangles in " << build_seconds << " s\n";
+    std::vector<CameraImage> images;
+    for (std::size_t c = 0; c < scene.cameras.size(); ++c) {
+        const scene::Camera& camera = scene.cameras[c];
+        const int width = scaled(camera.width, options.resolution_scale);
+        const int height = scaled(camera.height, options.resolution_scale);
+        const auto start = Clock::now();
+        Image image = renderer.render(camera, width, height, [&](int pixels) { on_tile(c, pixels); });
+        const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+        images.push_back({c, camera.image_name, std::move(image), seconds});
+    }
+    return images;
+}
+
+}  // namespace detail
+
+// Renders every camera. `on_tile(camera, pixels)` reports progress from worker threads.
+inline std::vector<CameraImage> render_scene(
+    const scene::Scene& scene, const RenderOptions& options, std::ostream& log,
+    const std::function<void(std::size_t camera, int pixels)>& on_tile = [](std::size_t, int) {}) {
+    for (const auto& camera : scene.cameras)
+        if (camera.width <= 0 || camera.height <= 0)
+            throw std::invalid_argument("camera " + camera.id + ": image size must be positive");
+    if (!scene.unsupported.empty()) {
+        log << "warning: not rendered yet:";
+        for (const auto& name : scene.unsupported) log << ' ' << name;
+        log << '\n';
+    }
+    const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
+    tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+    const Choice choice = choose_precision(scene, options);
+    log << "configuration: " << to_string(choice.precision) << ", BVH with watertight triangle tests, point lights ("
+        << choice.reason << ")\n";
+    switch (choice.precision) {
+        case Precision::single:
+            return detail::render_with<Config<float, Bvh<Watertight>, Lights<PointLight>>>(scene, options, log, on_tile);
+        case Precision::double_refine:
+        case Precision::double_all:
+            return detail::render_with<Config<double, Bvh<Watertight>, Lights<PointLight>>>(scene, options, log, on_tile);
+    }
+    throw std::logic_error("unknown precision");
 }
 
 }  // namespace prism

@@ -1,0 +1,135 @@
+// prism: renders every camera of a CENG795 scene file (XML or JSON) into its image file.
+// All cameras are rendered before any file is written, so a failure leaves no partial output.
+#include <prism/image/image_io.hpp>
+#include <prism/io/load.hpp>
+#include <prism/render/progress.hpp>
+#include <prism/render/render_scene.hpp>
+
+#include <charconv>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace {
+
+constexpr const char* usage = R"(usage: prism SCENE [options]
+
+Renders every camera of SCENE (a CENG795 .xml or .json scene file) and writes each camera's
+image under the name the scene gives it (.png: clamped to 0-255; .exr: linear radiance).
+
+options:
+  --output-dir DIR     folder for the images (default: the current folder); created if missing
+  --threads N          worker threads (default: all hardware threads)
+  --precision P        float | double-refine | double: override the precision chosen from the
+                       scene (the choice and its reason are printed)
+  --scale S            render at S times the cameras' resolution (0 < S <= 1; quick previews)
+  --cull-backfaces     primary rays ignore triangles facing away from the camera
+  --quiet              print nothing but errors
+  --help               this text
+
+exit status: 0 on success; 1 when the scene cannot be loaded, rendered or written (one line on
+stderr names the file and the element at fault, and no image is written); 2 for usage errors.
+)";
+
+struct Arguments {
+    std::filesystem::path scene;
+    std::filesystem::path output_dir = ".";
+    prism::RenderOptions options;
+    bool quiet = false;
+};
+
+[[noreturn]] void usage_error(const std::string& message) {
+    std::cerr << "prism: " << message << "\n(see prism --help)\n";
+    std::exit(2);
+}
+
+template <class Number>
+Number parse_number(std::string_view option, std::string_view text) {
+    Number value{};
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (error != std::errc() || end != text.data() + text.size())
+        usage_error(std::string(option) + ": not a number: '" + std::string(text) + "'");
+    return value;
+}
+
+Arguments parse_arguments(int argc, char** argv) {
+    Arguments arguments;
+    std::vector<std::string_view> args(argv + 1, argv + argc);
+    for (std::size_t i = 0; i < args.size(); ++i) {
+        const std::string_view arg = args[i];
+        const auto value = [&]() -> std::string_view {
+            if (i + 1 >= args.size()) usage_error(std::string(arg) + " needs a value");
+            return args[++i];
+        };
+        if (arg == "--help" || arg == "-h") {
+            std::cout << usage;
+            std::exit(0);
+        } else if (arg == "--output-dir") {
+            arguments.output_dir = std::filesystem::path(value());
+        } else if (arg == "--threads") {
+            arguments.options.threads = parse_number<int>(arg, value());
+            if (arguments.options.threads < 1) usage_error("--threads must be at least 1");
+        } else if (arg == "--precision") {
+            const std::string_view p = value();
+            if (p == "float") arguments.options.precision = prism::Precision::single;
+            else if (p == "double-refine") arguments.options.precision = prism::Precision::double_refine;
+            else if (p == "double") arguments.options.precision = prism::Precision::double_all;
+            else usage_error("--precision must be float, double-refine or double");
+        } else if (arg == "--scale") {
+            arguments.options.resolution_scale = parse_number<double>(arg, value());
+            if (!(arguments.options.resolution_scale > 0 && arguments.options.resolution_scale <= 1))
+                usage_error("--scale must be in (0, 1]");
+        } else if (arg == "--cull-backfaces") {
+            arguments.options.cull_backfaces = true;
+        } else if (arg == "--quiet") {
+            arguments.quiet = true;
+        } else if (!arg.empty() && arg[0] == '-') {
+            usage_error("unknown option " + std::string(arg));
+        } else if (arguments.scene.empty()) {
+            arguments.scene = std::filesystem::path(arg);
+        } else {
+            usage_error("more than one scene given");
+        }
+    }
+    if (arguments.scene.empty()) usage_error("no scene given");
+    return arguments;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const Arguments arguments = parse_arguments(argc, argv);
+    std::ostringstream silent;
+    std::ostream& log = arguments.quiet ? static_cast<std::ostream&>(silent) : std::cout;
+    try {
+        const prism::scene::Scene scene = prism::io::load_scene(arguments.scene);
+        if (scene.cameras.empty()) throw prism::io::LoadError(arguments.scene, "<Cameras>", "the scene has no camera");
+
+        std::size_t total_pixels = 0;
+        for (const auto& camera : scene.cameras)
+            total_pixels += std::size_t(std::max(1L, std::lround(camera.width * arguments.options.resolution_scale))) *
+                            std::size_t(std::max(1L, std::lround(camera.height * arguments.options.resolution_scale)));
+        prism::ProgressBar progress(total_pixels, !arguments.quiet);
+        const auto images = prism::render_scene(scene, arguments.options, log,
+                                                [&](std::size_t, int pixels) { progress.advance(std::size_t(pixels)); });
+        progress.finish();
+
+        for (const auto& rendered : images) {
+            const std::filesystem::path path = arguments.output_dir / rendered.image_name;
+            prism::write_image(path, rendered.image);
+            log << "camera " << scene.cameras[rendered.camera].id << ": " << path.string() << " ("
+                << rendered.image.width << "x" << rendered.image.height << ") rendered in " << rendered.seconds
+                << " s\n";
+        }
+    } catch (const std::exception& error) {
+        std::cerr << "prism: " << error.what() << '\n';
+        return 1;
+    }
+    return 0;
+}

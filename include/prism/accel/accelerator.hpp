@@ -1,0 +1,50 @@
+// Acceleration policies and the concepts they satisfy. A policy names the spatial index (BVH or
+// brute force) and the triangle intersector its leaves call; the geometry built from a policy
+// is an Accelerator: closest hit and any hit, nothing more.
+#pragma once
+
+#include <prism/accel/bvh_tree.hpp>
+#include <prism/accel/primitive_list.hpp>
+#include <prism/geometry/triangle_hit.hpp>
+#include <prism/geometry/watertight.hpp>
+
+#include <concepts>
+#include <span>
+
+namespace prism {
+
+template <Scalar Real> struct Hit;
+
+// A spatial index over boxes, traversed with a leaf callback (BvhTree, PrimitiveList).
+template <class I, class Real>
+concept SpatialIndex = Scalar<Real> && requires(const I& index, std::span<const Aabb<Real>> boxes,
+                                                const Ray<Real>& ray, Real t) {
+    { I::build(boxes) } -> std::same_as<I>;
+    { index.primitive_indices() };
+    { index.traverse_any(ray, t, [](std::uint32_t, std::uint32_t, Real&) { return true; }) } -> std::same_as<bool>;
+};
+
+template <class A, class Real>
+concept Accelerator = Scalar<Real> && requires(const A& accel, Ray<Real>& ray, const Ray<Real>& shadow_ray,
+                                               Hit<Real>& hit) {
+    { accel.intersect(ray, hit) } -> std::same_as<bool>;
+    { accel.occluded(shadow_ray) } -> std::same_as<bool>;
+};
+
+template <class IntersectorT = Watertight>
+struct Bvh {
+    using Intersector = IntersectorT;
+    template <Scalar Real> using Index = BvhTree<Real>;
+};
+
+template <class IntersectorT = Watertight>
+struct BruteForce {
+    using Intersector = IntersectorT;
+    template <Scalar Real> using Index = PrimitiveList<Real>;
+};
+
+template <class P, class Real>
+concept AccelerationPolicy = Scalar<Real> && TriangleIntersector<typename P::Intersector, Real> &&
+                             SpatialIndex<typename P::template Index<Real>, Real>;
+
+}  // namespace prism

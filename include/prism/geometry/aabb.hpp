@@ -1,0 +1,64 @@
+// Axis-aligned bounding box, and the slab test the BVH traversal runs at every node.
+#pragma once
+
+#include <prism/geometry/ray.hpp>
+
+#include <algorithm>
+
+namespace prism {
+
+template <Scalar Real>
+struct Aabb {
+    Vec3<Real> min{infinity<Real>};
+    Vec3<Real> max{-infinity<Real>};
+
+    static Aabb empty() { return {}; }
+
+    void extend(const Vec3<Real>& p) {
+        min = glm::min(min, p);
+        max = glm::max(max, p);
+    }
+    void extend(const Aabb& b) {
+        min = glm::min(min, b.min);
+        max = glm::max(max, b.max);
+    }
+    bool is_empty() const { return min.x > max.x || min.y > max.y || min.z > max.z; }
+    Vec3<Real> extent() const { return max - min; }
+    Vec3<Real> centroid() const { return (min + max) * Real(0.5); }
+    Real half_area() const {
+        if (is_empty()) return 0;
+        const Vec3<Real> e = extent();
+        return e.x * e.y + e.y * e.z + e.z * e.x;
+    }
+    Vec3<Real> corner(int i) const {
+        return {(i & 1) ? max.x : min.x, (i & 2) ? max.y : min.y, (i & 4) ? max.z : min.z};
+    }
+};
+
+// What the slab test needs of a ray, computed once per ray rather than once per node.
+template <Scalar Real>
+struct RayBoxPrecomputed {
+    Vec3<Real> origin;
+    Vec3<Real> inverse_direction;
+
+    explicit RayBoxPrecomputed(const Ray<Real>& ray) : origin(ray.origin) {
+        // 1/0 = inf is what the slab test wants; -0 gives -inf, which is also right.
+        inverse_direction = Vec3<Real>(Real(1)) / ray.direction;
+    }
+};
+
+// Returns the entry distance, or infinity when the box is missed within [t_min, t_max].
+// The min/max ordering makes NaNs (0 * inf on a slab plane) drop out instead of accepting.
+template <Scalar Real>
+inline Real intersect_box(const Aabb<Real>& box, const RayBoxPrecomputed<Real>& ray, Real t_min, Real t_max) {
+    for (int axis = 0; axis < 3; ++axis) {
+        Real t0 = (box.min[axis] - ray.origin[axis]) * ray.inverse_direction[axis];
+        Real t1 = (box.max[axis] - ray.origin[axis]) * ray.inverse_direction[axis];
+        if (t0 > t1) std::swap(t0, t1);
+        t_min = t0 > t_min ? t0 : t_min;
+        t_max = t1 < t_max ? t1 : t_max;
+    }
+    return t_min <= t_max ? t_min : infinity<Real>;
+}
+
+}  // namespace prism

@@ -1,0 +1,28 @@
+// The closest-hit record traversal fills, and the surface point shading derives from it once the
+// closest hit is known (so traversal never computes normals or texture coordinates it discards).
+#pragma once
+
+#include <prism/math/vector.hpp>
+
+#include <cstdint>
+
+namespace prism {
+
+template <Scalar Real>
+struct Hit {
+    Real t = infinity<Real>;
+    std::uint32_t object = 0;     // index of the instance (or plane) hit
+    std::uint32_t primitive = 0;  // triangle within a mesh; 0 for spheres and planes
+    Real b1 = 0, b2 = 0;          // barycentrics for triangles
+};
+
+template <Scalar Real>
+struct SurfacePoint {
+    Vec3<Real> position{0};
+    Vec3<Real> geometric_normal{0};  // unit, world space, as the surface is oriented (not flipped)
+    Vec3<Real> shading_normal{0};    // unit; interpolated for smooth meshes
+    Vec2<Real> uv{0};
+    std::uint32_t material = 0;
+};
+
+}  // namespace prism

@@ -1,0 +1,48 @@
+// Ray-sphere intersection in the sphere's object space. The quadratic is solved in the stable
+// form (Press et al., Numerical Recipes 5.6): q = -(b + sign(b) sqrt(disc)) / 2, roots q/a and
+// c/q, which avoids the cancellation of -b + sqrt(disc) when the ray starts near the sphere.
+#pragma once
+
+#include <prism/geometry/aabb.hpp>
+
+#include <cmath>
+
+namespace prism {
+
+template <Scalar Real>
+struct SphereShape {
+    Vec3<Real> center{0};
+    Real radius = 1;
+
+    Aabb<Real> bounds() const { return {center - Vec3<Real>(radius), center + Vec3<Real>(radius)}; }
+
+    // Nearest root in (t_min, t_max]; the direction need not be unit length.
+    bool intersect(const Ray<Real>& ray, Real t_min, Real t_max, Real& t_hit) const {
+        const Vec3<Real> oc = ray.origin - center;
+        const Real a = glm::dot(ray.direction, ray.direction);
+        const Real half_b = glm::dot(oc, ray.direction);
+        // c computed as |oc|^2 - r^2 would cancel catastrophically for far-away origins; the
+        // difference of squares on the perpendicular distance keeps the discriminant accurate
+        // (Haines et al., Ray Tracing Gems ch. 7).
+        const Vec3<Real> perpendicular = oc - (half_b / a) * ray.direction;
+        const Real discriminant_over_a = radius * radius - glm::dot(perpendicular, perpendicular);
+        if (discriminant_over_a < 0) return false;
+        const Real c = glm::dot(oc, oc) - radius * radius;
+        const Real root = std::sqrt(a * discriminant_over_a);
+        const Real q = half_b >= 0 ? -(half_b + root) : -(half_b - root);
+        Real t0 = c / q, t1 = q / a;
+        if (q == 0) t0 = t1 = 0;
+        if (t0 > t1) std::swap(t0, t1);
+        if (t0 > t_min && t0 <= t_max) {
+            t_hit = t0;
+            return true;
+        }
+        if (t1 > t_min && t1 <= t_max) {
+            t_hit = t1;
+            return true;
+        }
+        return false;
+    }
+};
+
+}  // namespace prism

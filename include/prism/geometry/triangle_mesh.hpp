@@ -1,0 +1,140 @@
+// A triangle mesh in its object space with its own spatial index: the bottom level of the
+// two-level hierarchy, shared by every instance of the mesh. Triangles are stored as a vertex
+// soup in index order, so a leaf reads contiguous memory; shading data stays indexed.
+#pragma once
+
+#include <prism/accel/accelerator.hpp>
+#include <prism/geometry/hit.hpp>
+#include <prism/scene/scene.hpp>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace prism {
+
+template <Scalar Real, class Policy>
+    requires AccelerationPolicy<Policy, Real>
+class TriangleMesh {
+public:
+    using Intersector = typename Policy::Intersector;
+    using Storage = typename Intersector::template Storage<Real>;
+    using Index = typename Policy::template Index<Real>;
+    using Prepared = typename Intersector::template Prepared<Real>;
+
+    explicit TriangleMesh(const scene::Mesh& mesh) : smooth_(mesh.shading == scene::ShadingMode::smooth) {
+        const std::size_t count = mesh.triangles.size();
+        std::vector<Aabb<Real>> boxes(count);
+        for (std::size_t i = 0; i < count; ++i) {
+            for (std::uint32_t v : mesh.triangles[i]) boxes[i].extend(Vec3<Real>(mesh.positions[v]));
+            bounds_.extend(boxes[i]);
+        }
+        index_ = Index::build(boxes);
+        const auto& order = index_.primitive_indices();
+        triangles_.resize(count);
+        faces_.resize(count);
+        for (std::size_t slot = 0; slot < count; ++slot) {
+            const auto& face = mesh.triangles[order[slot]];
+            faces_[slot] = face;
+            for (int k = 0; k < 3; ++k) triangles_[slot][k] = Vec3<Storage>(mesh.positions[face[k]]);
+        }
+        if (smooth_) vertex_normals_ = smooth_normals(mesh);
+        if (!mesh.uvs.empty())
+            for (const auto& uv : mesh.uvs) uvs_.emplace_back(uv);
+    }
+
+    Aabb<Real> bounds() const { return bounds_; }
+    std::size_t triangle_count() const { return triangles_.size(); }
+
+    // Closest hit along `ray` (object space) below t_max; lowers t_max and fills t, primitive,
+    // barycentrics. Culling skips triangles whose winding faces away from the ray.
+    template <bool CullBackfaces>
+    bool intersect(const Ray<Real>& ray, Real& t_max, Hit<Real>& hit) const {
+        const Prepared prepared(ray);
+        bool found = false;
+        index_.traverse_closest(ray, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
+            bool leaf_hit = false;
+            for (std::uint32_t slot = first; slot < first + count; ++slot) {
+                const auto& p = triangles_[slot];
+                if constexpr (CullBackfaces) {
+                    if (glm::dot(Vec3<Real>(glm::cross(p[1] - p[0], p[2] - p[0])), ray.direction) > 0) continue;
+                }
+                TriangleHit<Real> triangle_hit;
+                if (Intersector::intersect(prepared, p[0], p[1], p[2], ray.t_min, t_limit, triangle_hit)) {
+                    t_limit = triangle_hit.t;
+                    hit.t = triangle_hit.t;
+                    hit.primitive = slot;
+                    hit.b1 = triangle_hit.b1;
+                    hit.b2 = triangle_hit.b2;
+                    leaf_hit = true;
+                }
+            }
+            found |= leaf_hit;
+            return leaf_hit;
+        });
+        return found;
+    }
+
+    bool occluded(const Ray<Real>& ray, Real t_max) const {
+        const Prepared prepared(ray);
+        return index_.traverse_any(ray, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
+            for (std::uint32_t slot = first; slot < first + count; ++slot) {
+                const auto& p = triangles_[slot];
+                TriangleHit<Real> triangle_hit;
+                if (Intersector::intersect(prepared, p[0], p[1], p[2], ray.t_min, t_limit, triangle_hit)) return true;
+            }
+            return false;
+        });
+    }
+
+    // Object-space normals and texture coordinates at a hit.
+    void surface(const Hit<Real>& hit, Vec3<Real>& geometric_normal, Vec3<Real>& shading_normal,
+                 Vec2<Real>& uv) const {
+        const auto& p = triangles_[hit.primitive];
+        geometric_normal = glm::normalize(Vec3<Real>(glm::cross(p[1] - p[0], p[2] - p[0])));
+        const Real b0 = Real(1) - hit.b1 - hit.b2;
+        const auto& face = faces_[hit.primitive];
+        shading_normal = geometric_normal;
+        if (smooth_) {
+            const Vec3<Real> n = b0 * vertex_normals_[face[0]] + hit.b1 * vertex_normals_[face[1]] +
+                                 hit.b2 * vertex_normals_[face[2]];
+            const Real length = glm::length(n);
+            if (length > 0) shading_normal = n / length;
+        }
+        if (!uvs_.empty()) uv = b0 * uvs_[face[0]] + hit.b1 * uvs_[face[1]] + hit.b2 * uvs_[face[2]];
+    }
+
+private:
+    // Vertex normals as the course defines them: the normalised average of the unit normals of
+    // the faces that share the vertex. A PLY file's own normals take precedence.
+    static std::vector<Vec3<Real>> smooth_normals(const scene::Mesh& mesh) {
+        std::vector<Vec3<Real>> result(mesh.positions.size(), Vec3<Real>(0));
+        if (mesh.normals.size() == mesh.positions.size()) {
+            for (std::size_t i = 0; i < mesh.normals.size(); ++i) result[i] = Vec3<Real>(glm::normalize(mesh.normals[i]));
+            return result;
+        }
+        std::vector<glm::dvec3> sums(mesh.positions.size(), glm::dvec3(0.0));
+        for (const auto& face : mesh.triangles) {
+            const glm::dvec3 n = glm::cross(mesh.positions[face[1]] - mesh.positions[face[0]],
+                                            mesh.positions[face[2]] - mesh.positions[face[0]]);
+            const double length = glm::length(n);
+            if (!(length > 0)) continue;
+            for (std::uint32_t v : face) sums[v] += n / length;
+        }
+        for (std::size_t i = 0; i < sums.size(); ++i) {
+            const double length = glm::length(sums[i]);
+            if (length > 0) result[i] = Vec3<Real>(sums[i] / length);
+        }
+        return result;
+    }
+
+    bool smooth_ = false;
+    Aabb<Real> bounds_;
+    Index index_;
+    std::vector<std::array<Vec3<Storage>, 3>> triangles_;  // in index order
+    std::vector<std::array<std::uint32_t, 3>> faces_;      // vertex indices, in index order
+    std::vector<Vec3<Real>> vertex_normals_;
+    std::vector<Vec2<Real>> uvs_;
+};
+
+}  // namespace prism

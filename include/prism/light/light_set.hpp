@@ -1,0 +1,50 @@
+// A compile-time set of light types. `Lights<PointLight, SpotLight>` is the policy a Config
+// names; `LightSet<Real, ...>` holds one vector per type and visits them with a fold
+// expression, so a renderer compiled for point lights contains no code for any other light.
+#pragma once
+
+#include <prism/light/light_sample.hpp>
+
+#include <cstddef>
+#include <tuple>
+#include <vector>
+
+namespace prism {
+
+template <Scalar Real, template <class> class... LightTypes>
+    requires(Light<LightTypes<Real>, Real> && ...)
+class LightSet {
+public:
+    explicit LightSet(const scene::Scene& scene) : lights_(LightTypes<Real>::from_scene(scene)...) {}
+
+    // Calls visit(light) for every light of every type.
+    template <class Visit>
+    void for_each(Visit&& visit) const {
+        std::apply([&](const auto&... vectors) { (visit_all(vectors, visit), ...); }, lights_);
+    }
+
+    std::size_t size() const {
+        return std::apply([](const auto&... vectors) { return (std::size_t(0) + ... + vectors.size()); }, lights_);
+    }
+
+private:
+    template <class Vector, class Visit>
+    static void visit_all(const Vector& lights, Visit& visit) {
+        for (const auto& light : lights) visit(light);
+    }
+
+    std::tuple<std::vector<LightTypes<Real>>...> lights_;
+};
+
+template <template <class> class... LightTypes>
+struct Lights {
+    template <Scalar Real> using Set = LightSet<Real, LightTypes...>;
+
+    // How many of the scene's lights this set can represent; a dispatcher compares it with the
+    // scene's total so that no light is silently dropped.
+    static std::size_t count_in(const scene::Scene& scene) {
+        return (std::size_t(0) + ... + LightTypes<double>::count_in(scene));
+    }
+};
+
+}  // namespace prism

@@ -1,0 +1,34 @@
+// Vector and matrix aliases on GLM, templated on the scalar type, and the concept that names the
+// scalar types prism is built for. Explicit aliases rather than injected macros, so the reader of
+// any header sees the types it works with.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include <concepts>
+#include <limits>
+
+namespace prism {
+
+template <class T>
+concept Scalar = std::same_as<T, float> || std::same_as<T, double>;
+
+template <class Real> using Vec2 = glm::vec<2, Real, glm::defaultp>;
+template <class Real> using Vec3 = glm::vec<3, Real, glm::defaultp>;
+template <class Real> using Vec4 = glm::vec<4, Real, glm::defaultp>;
+template <class Real> using Mat3 = glm::mat<3, 3, Real, glm::defaultp>;
+template <class Real> using Mat4 = glm::mat<4, 4, Real, glm::defaultp>;
+
+template <Scalar Real>
+constexpr Real infinity = std::numeric_limits<Real>::infinity();
+
+template <Scalar Real>
+constexpr Real pi = Real(3.14159265358979323846);
+
+// The component of largest magnitude; the watertight test picks its projection axis with it.
+template <Scalar Real>
+inline int max_dimension(const Vec3<Real>& v) {
+    return v.x > v.y ? (v.x > v.z ? 0 : 2) : (v.y > v.z ? 1 : 2);
+}
+
+}  // namespace prism

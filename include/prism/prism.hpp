@@ -1,0 +1,15 @@
+// The umbrella include: the whole toolkit, from the plain scene description to the renderer.
+#pragma once
+
+#include <prism/accel/accelerator.hpp>
+#include <prism/camera/pinhole_camera.hpp>
+#include <prism/geometry/naive_epsilon.hpp>
+#include <prism/geometry/scene_geometry.hpp>
+#include <prism/geometry/watertight.hpp>
+#include <prism/image/image.hpp>
+#include <prism/light/light_set.hpp>
+#include <prism/light/point_light.hpp>
+#include <prism/render/config.hpp>
+#include <prism/render/render_scene.hpp>
+#include <prism/render/renderer.hpp>
+#include <prism/scene/scene.hpp>
