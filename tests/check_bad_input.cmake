@@ -1,0 +1,32 @@
+# Runs the prism renderer on one broken scene and checks what a user must get: a non-zero exit,
+# exactly one line on stderr naming the scene (or asset) file and the element at fault, no crash
+# and no image file left behind.
+#   cmake -DPRISM=... -DSCENE=... -DEXPECT_FILE=... -DEXPECT_ELEMENT=... -DOUTPUT_DIR=... -P check_bad_input.cmake
+file(REMOVE_RECURSE "${OUTPUT_DIR}")
+execute_process(COMMAND "${PRISM}" "${SCENE}" --output-dir "${OUTPUT_DIR}" --quiet
+                RESULT_VARIABLE result ERROR_VARIABLE errors OUTPUT_VARIABLE output)
+message(STATUS "exit: ${result}\nstderr: ${errors}")
+if(NOT result MATCHES "^[0-9]+$")
+  message(FATAL_ERROR "prism did not exit normally (${result}): a crash")
+endif()
+if(result EQUAL 0)
+  message(FATAL_ERROR "prism exited 0 on a broken scene")
+endif()
+string(STRIP "${errors}" errors)
+string(REGEX MATCHALL "\n" newlines "${errors}")
+list(LENGTH newlines extra_lines)
+if(NOT extra_lines EQUAL 0)
+  message(FATAL_ERROR "expected one line on stderr, got ${extra_lines} more")
+endif()
+if(NOT errors MATCHES "${EXPECT_FILE}")
+  message(FATAL_ERROR "the message does not name the file '${EXPECT_FILE}'")
+endif()
+if(NOT errors MATCHES "${EXPECT_ELEMENT}")
+  message(FATAL_ERROR "the message does not name the element '${EXPECT_ELEMENT}'")
+endif()
+if(EXISTS "${OUTPUT_DIR}")
+  file(GLOB_RECURSE written "${OUTPUT_DIR}/*")
+  if(written)
+    message(FATAL_ERROR "files were written: ${written}")
+  endif()
+endif()
