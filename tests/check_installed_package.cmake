@@ -2,7 +2,7 @@
 # project would: find_package(prism CONFIG REQUIRED) + target_link_libraries(... prism::prism).
 set(prefix "${WORK_DIR}/prefix")
 file(REMOVE_RECURSE "${WORK_DIR}")
-execute_process(COMMAND ${CMAKE_COMMAND} --install "${PRISM_BINARY_DIR}" --prefix "${prefix}" --component Unspecified
+execute_process(COMMAND ${CMAKE_COMMAND} --install "${PRISM_BINARY_DIR}" --prefix "${prefix}"
                 RESULT_VARIABLE result OUTPUT_QUIET)
 if(NOT result EQUAL 0)
   message(FATAL_ERROR "cmake --install failed")
