@@ -3,6 +3,7 @@
 
 #include <prism/accel/accelerator.hpp>
 #include <prism/camera/pinhole_camera.hpp>
+#include <prism/geometry/double_refine.hpp>
 #include <prism/geometry/naive_epsilon.hpp>
 #include <prism/geometry/scene_geometry.hpp>
 #include <prism/geometry/watertight.hpp>

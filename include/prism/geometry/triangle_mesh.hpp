@@ -5,10 +5,12 @@
 
 #include <prism/accel/accelerator.hpp>
 #include <prism/geometry/hit.hpp>
+#include <prism/math/floating_point.hpp>
 #include <prism/scene/scene.hpp>
 
 #include <array>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 namespace prism {
@@ -27,6 +29,14 @@ public:
         std::vector<Aabb<Real>> boxes(count);
         for (std::size_t i = 0; i < count; ++i) {
             for (std::uint32_t v : mesh.triangles[i]) boxes[i].extend(Vec3<Real>(mesh.positions[v]));
+            // Vertices kept wider than Real are rounded for the box: widen it by one ulp on
+            // each side so the box still contains the triangle the intersector tests.
+            if constexpr (!std::is_same_v<Storage, Real>) {
+                for (int axis = 0; axis < 3; ++axis) {
+                    boxes[i].min[axis] = next_down(boxes[i].min[axis]);
+                    boxes[i].max[axis] = next_up(boxes[i].max[axis]);
+                }
+            }
             bounds_.extend(boxes[i]);
         }
         index_ = Index::build(boxes);
