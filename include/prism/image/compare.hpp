@@ -1,0 +1,102 @@
+// Image comparison for the scene suite: PSNR and the share of visibly wrong pixels over 8-bit RGB
+// (what the PNG files hold), and an area-averaging box filter that brings a full-size reference
+// down to the size of a reduced-resolution render.
+#pragma once
+
+#include <prism/image/image.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+namespace prism {
+
+// Peak signal-to-noise ratio in dB over every channel value, with 255 as the peak; infinity for
+// identical images, so "equal" never hides behind a large finite number.
+inline double psnr(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b) {
+    if (a.size() != b.size()) throw std::invalid_argument("psnr: the images differ in size");
+    if (a.empty()) throw std::invalid_argument("psnr: empty images");
+    double sum_of_squares = 0.0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        const double difference = double(a[i]) - double(b[i]);
+        sum_of_squares += difference * difference;
+    }
+    if (sum_of_squares == 0.0) return std::numeric_limits<double>::infinity();
+    const double mean_square = sum_of_squares / double(a.size());
+    return 10.0 * std::log10(255.0 * 255.0 / mean_square);
+}
+
+// Share (0..1) of RGB pixels where any channel differs by more than `levels`: PSNR averages a
+// few badly wrong pixels away, this does not.
+inline double share_off_by_more_than(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b,
+                                     int levels) {
+    if (a.size() != b.size()) throw std::invalid_argument("share_off_by_more_than: the images differ in size");
+    if (a.size() % 3 != 0) throw std::invalid_argument("share_off_by_more_than: not RGB data");
+    const std::size_t pixels = a.size() / 3;
+    if (pixels == 0) return 0.0;
+    std::size_t off = 0;
+    for (std::size_t p = 0; p < pixels; ++p)
+        for (std::size_t c = 0; c < 3; ++c)
+            if (std::abs(int(a[3 * p + c]) - int(b[3 * p + c])) > levels) {
+                ++off;
+                break;
+            }
+    return double(off) / double(pixels);
+}
+
+namespace detail {
+
+struct BoxTap {
+    int source;
+    double weight;  // overlap length, in source pixels
+};
+
+// For each target pixel along one axis, the source pixels its footprint
+// [t * source/target, (t+1) * source/target) overlaps and by how much. Computing the edges as
+// t * source / target (not t * ratio) keeps them exact for integer ratios.
+inline std::vector<std::vector<BoxTap>> box_taps(int source, int target) {
+    std::vector<std::vector<BoxTap>> taps(static_cast<std::size_t>(target));
+    for (int t = 0; t < target; ++t) {
+        const double begin = double(t) * source / target;
+        const double end = double(t + 1) * source / target;
+        for (int s = int(std::floor(begin)); s < source && double(s) < end; ++s) {
+            const double overlap = std::min(end, double(s + 1)) - std::max(begin, double(s));
+            if (overlap > 0.0) taps[std::size_t(t)].push_back({s, overlap});
+        }
+    }
+    return taps;
+}
+
+}  // namespace detail
+
+// Resamples by area: every target pixel is the average of the source area it covers, partial
+// source pixels weighted by their covered fraction, so the image mean is preserved for any ratio
+// (5x5 -> 2x2 as well as 4x4 -> 2x2).
+inline Image downsample_box(const Image& source, int width, int height) {
+    if (width <= 0 || height <= 0) throw std::invalid_argument("downsample_box: target size must be positive");
+    if (source.width <= 0 || source.height <= 0) throw std::invalid_argument("downsample_box: empty source image");
+    const auto columns = detail::box_taps(source.width, width);
+    const auto rows = detail::box_taps(source.height, height);
+    Image target(width, height);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            double sum[3] = {0.0, 0.0, 0.0};
+            double total_weight = 0.0;
+            for (const auto& row : rows[std::size_t(y)])
+                for (const auto& column : columns[std::size_t(x)]) {
+                    const double weight = row.weight * column.weight;
+                    const glm::vec3& pixel = source(column.source, row.source);
+                    for (int c = 0; c < 3; ++c) sum[c] += weight * double(pixel[c]);
+                    total_weight += weight;
+                }
+            target(x, y) = glm::vec3(float(sum[0] / total_weight), float(sum[1] / total_weight),
+                                     float(sum[2] / total_weight));
+        }
+    return target;
+}
+
+}  // namespace prism

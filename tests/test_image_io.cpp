@@ -1,0 +1,248 @@
+// Image files and image comparison: round trips through PNG and EXR, the shared environment maps
+// (tiled and scanline EXR, Radiance HDR), PSNR, the off-pixel share, the box filter, and writes
+// that must fail without leaving anything behind.
+#include <prism/image/compare.hpp>
+#include <prism/image/image_io.hpp>
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+
+#ifndef PRISM_SHARED_DIR
+#define PRISM_SHARED_DIR "../shared"
+#endif
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A fresh, empty folder per test case, removed when the case ends.
+struct ScratchFolder {
+    fs::path path;
+    explicit ScratchFolder(const std::string& name)
+        : path(fs::temp_directory_path() / ("prism_test_image_io_" + std::to_string(::getpid()) + "_" + name)) {
+        fs::remove_all(path);
+        fs::create_directories(path);
+    }
+    ~ScratchFolder() {
+        std::error_code ignored;
+        fs::remove_all(path, ignored);
+    }
+    std::size_t entry_count() const {
+        return std::size_t(std::distance(fs::recursive_directory_iterator(path), fs::recursive_directory_iterator()));
+    }
+};
+
+fs::path shared_envmap(const char* name) { return fs::path(PRISM_SHARED_DIR) / "envmaps" / name; }
+
+bool all_finite(const prism::Image& image) {
+    for (const auto& pixel : image.pixels)
+        if (!std::isfinite(pixel.r) || !std::isfinite(pixel.g) || !std::isfinite(pixel.b)) return false;
+    return true;
+}
+
+prism::Image constant_image(int width, int height, glm::vec3 value) {
+    prism::Image image(width, height);
+    for (auto& pixel : image.pixels) pixel = value;
+    return image;
+}
+
+glm::dvec3 mean(const prism::Image& image) {
+    glm::dvec3 sum(0.0);
+    for (const auto& pixel : image.pixels) sum += glm::dvec3(pixel);
+    return sum / double(image.pixels.size());
+}
+
+}  // namespace
+
+TEST_CASE("to_8bit clamps to 0..255 and rounds to nearest") {
+    prism::Image image(4, 2);
+    const float values[8] = {-5.0f, 0.49999997f, 0.5f, 1.49f, 127.5f, 254.6f, 255.0f, 1e9f};
+    const std::uint8_t expected[8] = {0, 0, 1, 1, 128, 255, 255, 255};
+    for (int i = 0; i < 8; ++i) image.pixels[std::size_t(i)] = glm::vec3(values[i]);
+    image.pixels[0].g = std::numeric_limits<float>::quiet_NaN();
+    const auto bytes = prism::to_8bit(image);
+    REQUIRE(bytes.size() == 24);
+    for (int i = 0; i < 8; ++i) CHECK(int(bytes[std::size_t(3 * i + 2)]) == int(expected[i]));
+    CHECK(bytes[1] == 0);  // NaN is black
+}
+
+TEST_CASE("PNG round trip holds exactly the to_8bit values") {
+    ScratchFolder folder("png");
+    prism::Image image(7, 5);  // odd width: rows are not 4-byte aligned
+    for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x)
+            image(x, y) = glm::vec3(float(x) * 40.3f - 20.0f, float(y) * 70.7f, float(x * y) * 9.5f + 0.5f);
+    const fs::path file = folder.path / "nested" / "round_trip.PNG";  // missing folder, upper-case extension
+    prism::write_image(file, image);
+    const prism::Image read = prism::read_image(file);
+    REQUIRE(read.width == image.width);
+    REQUIRE(read.height == image.height);
+    const auto expected = prism::to_8bit(image);
+    CHECK(prism::to_8bit(read) == expected);
+    for (std::size_t i = 0; i < read.pixels.size(); ++i)
+        for (int c = 0; c < 3; ++c) CHECK(read.pixels[i][c] == float(expected[3 * i + std::size_t(c)]));
+    CHECK(folder.entry_count() == 2);  // the folder and the file: no temporary left behind
+}
+
+TEST_CASE("EXR round trip is bit-identical, in B,G,R channel order") {
+    ScratchFolder folder("exr");
+    prism::Image image(19, 17);  // larger than 16x16, so the ZIP-compressed path is taken
+    const float specials[] = {0.0f, 1.0f, 255.0f, 1e6f, 3.4e38f, 1e-30f, 1e-40f /* subnormal */,
+                              -2.5f, 0.1f, 1.0f / 3.0f};
+    std::size_t n = 0;
+    for (auto& pixel : image.pixels) {
+        pixel = glm::vec3(specials[n % 10], specials[(n + 3) % 10] * 1.5f, float(n) * 0.0123f);
+        ++n;
+    }
+    image.pixels[0] = glm::vec3(1.0f, 2.0f, 3.0f);  // distinct channels: a swapped order shows
+    const fs::path file = folder.path / "round_trip.exr";
+    prism::write_image(file, image);
+    const prism::Image read = prism::read_image(file);
+    REQUIRE(read.width == image.width);
+    REQUIRE(read.height == image.height);
+    std::size_t mismatches = 0;
+    for (std::size_t i = 0; i < image.pixels.size(); ++i)
+        for (int c = 0; c < 3; ++c)
+            if (std::memcmp(&read.pixels[i][c], &image.pixels[i][c], sizeof(float)) != 0) ++mismatches;
+    CHECK(mismatches == 0);
+    CHECK(read.pixels[0] == glm::vec3(1.0f, 2.0f, 3.0f));
+
+    EXRVersion version;
+    REQUIRE(ParseEXRVersionFromFile(&version, file.c_str()) == TINYEXR_SUCCESS);
+    EXRHeader header;
+    InitEXRHeader(&header);
+    const char* error = nullptr;
+    REQUIRE(ParseEXRHeaderFromFile(&header, &version, file.c_str(), &error) == TINYEXR_SUCCESS);
+    REQUIRE(header.num_channels == 3);
+    CHECK(std::string(header.channels[0].name) == "B");
+    CHECK(std::string(header.channels[1].name) == "G");
+    CHECK(std::string(header.channels[2].name) == "R");
+    for (int c = 0; c < 3; ++c) CHECK(header.pixel_types[c] == TINYEXR_PIXELTYPE_FLOAT);
+    FreeEXRHeader(&header);
+}
+
+TEST_CASE("the shared environment maps read: tiled and scanline EXR, Radiance HDR") {
+    if (!fs::is_directory(fs::path(PRISM_SHARED_DIR) / "envmaps")) {
+        MESSAGE("skipped: " PRISM_SHARED_DIR "/envmaps not found");
+        return;
+    }
+    for (const char* name : {"KernerEnvLatLong.exr", "pbrtv2_grace_latlong.exr"}) {
+        CAPTURE(name);
+        const prism::Image image = prism::read_image(shared_envmap(name));
+        CHECK(image.width == 1024);
+        CHECK(image.height == 512);
+        CHECK(all_finite(image));
+        CHECK(mean(image).g > 0.0);  // a map of zeros would mean the channels were not found
+    }
+    const prism::Image hdr = prism::read_image(shared_envmap("probulator_grace_latlong.hdr"));
+    CHECK(hdr.width == 256);
+    CHECK(hdr.height == 128);
+    CHECK(all_finite(hdr));
+    CHECK(mean(hdr).g > 0.0);
+}
+
+TEST_CASE("reading a missing or unknown file names the file") {
+    ScratchFolder folder("read_errors");
+    const fs::path missing = folder.path / "missing.png";
+    CHECK_THROWS_WITH_AS(prism::read_image(missing), doctest::Contains("missing.png"), prism::io::LoadError);
+    const fs::path text = folder.path / "not_an_image.png";
+    std::ofstream(text) << "hello";
+    CHECK_THROWS_WITH_AS(prism::read_image(text), doctest::Contains("not_an_image.png"), prism::io::LoadError);
+    const fs::path broken_exr = folder.path / "broken.exr";
+    std::ofstream(broken_exr) << "v/1\x01 not really";
+    CHECK_THROWS_WITH_AS(prism::read_image(broken_exr), doctest::Contains("broken.exr"), prism::io::LoadError);
+}
+
+TEST_CASE("psnr against a hand-computed value") {
+    const std::vector<std::uint8_t> a = {10, 20, 30, 40, 50, 60};
+    const std::vector<std::uint8_t> b = {12, 20, 30, 40, 50, 57};
+    // squared errors 4 + 9 = 13 over 6 values: 10 log10(255^2 * 6 / 13)
+    CHECK(prism::psnr(a, b) == doctest::Approx(44.77288258944717).epsilon(1e-12));
+    CHECK(prism::psnr(a, a) == std::numeric_limits<double>::infinity());
+    CHECK_THROWS_AS(prism::psnr(a, {1, 2, 3}), std::invalid_argument);
+}
+
+TEST_CASE("share_off_by_more_than counts pixels, not channels") {
+    // four pixels: equal; off by exactly 8 (not more); off by 9 in one channel; off by 9 in all
+    const std::vector<std::uint8_t> a = {0, 0, 0, 100, 100, 100, 50, 50, 50, 200, 200, 200};
+    const std::vector<std::uint8_t> b = {0, 0, 0, 108, 92, 100, 50, 59, 50, 191, 209, 191};
+    CHECK(prism::share_off_by_more_than(a, b, 8) == doctest::Approx(0.5));
+    CHECK(prism::share_off_by_more_than(a, b, 7) == doctest::Approx(0.75));
+    CHECK(prism::share_off_by_more_than(a, b, 9) == 0.0);
+    CHECK(prism::share_off_by_more_than(a, a, 0) == 0.0);
+}
+
+TEST_CASE("downsample_box averages by area") {
+    SUBCASE("a constant image stays constant") {
+        const prism::Image reduced = prism::downsample_box(constant_image(13, 7, {3.0f, 100.0f, 0.25f}), 5, 3);
+        REQUIRE(reduced.width == 5);
+        REQUIRE(reduced.height == 3);
+        for (const auto& pixel : reduced.pixels) {
+            CHECK(pixel.r == doctest::Approx(3.0));
+            CHECK(pixel.g == doctest::Approx(100.0));
+            CHECK(pixel.b == doctest::Approx(0.25));
+        }
+    }
+    SUBCASE("a 4x4 checker to 2x2 gives each quadrant's average") {
+        prism::Image checker(4, 4);
+        for (int y = 0; y < 4; ++y)
+            for (int x = 0; x < 4; ++x) checker(x, y) = glm::vec3(float((x + y) % 2) * 255.0f, float(x + 4 * y), 0.0f);
+        const prism::Image reduced = prism::downsample_box(checker, 2, 2);
+        for (int y = 0; y < 2; ++y)
+            for (int x = 0; x < 2; ++x) {
+                CHECK(reduced(x, y).r == doctest::Approx(127.5));
+                // green: the mean of x + 4y over the quadrant's four pixels
+                const double expected = (2 * x + 0.5) + 4.0 * (2 * y + 0.5);
+                CHECK(reduced(x, y).g == doctest::Approx(expected));
+            }
+    }
+    SUBCASE("a non-integer ratio (5x5 to 2x2) preserves the mean and weights partial pixels") {
+        prism::Image ramp(5, 5);
+        for (int y = 0; y < 5; ++y)
+            for (int x = 0; x < 5; ++x) ramp(x, y) = glm::vec3(float(x), float(y * y), float(x * 7 + y));
+        const prism::Image reduced = prism::downsample_box(ramp, 2, 2);
+        const glm::dvec3 before = mean(ramp), after = mean(reduced);
+        for (int c = 0; c < 3; ++c) CHECK(after[c] == doctest::Approx(before[c]).epsilon(1e-6));
+        // left half covers x in [0, 2.5): (0 + 1 + 0.5 * 2) / 2.5
+        CHECK(reduced(0, 0).r == doctest::Approx(0.8));
+        CHECK(reduced(1, 0).r == doctest::Approx((0.5 * 2 + 3 + 4) / 2.5));
+    }
+}
+
+TEST_CASE("write_image fails whole: no partial file, nothing behind") {
+    ScratchFolder folder("write_errors");
+    const prism::Image image = constant_image(3, 2, {10.0f, 20.0f, 30.0f});
+
+    SUBCASE("a folder that cannot be created (under a regular file)") {
+        std::ofstream(folder.path / "plain_file") << "x";
+        CHECK_THROWS_AS(prism::write_image(folder.path / "plain_file" / "sub" / "out.png", image), prism::io::LoadError);
+        CHECK_THROWS_AS(prism::write_image(folder.path / "plain_file" / "out.exr", image), prism::io::LoadError);
+        CHECK(folder.entry_count() == 1);
+    }
+    SUBCASE("the target is a folder: the temporary file is removed") {
+        fs::create_directories(folder.path / "taken.png");
+        CHECK_THROWS_AS(prism::write_image(folder.path / "taken.png", image), prism::io::LoadError);
+        CHECK(folder.entry_count() == 1);
+    }
+    SUBCASE("an unknown extension") {
+        CHECK_THROWS_WITH_AS(prism::write_image(folder.path / "out.ppm", image), doctest::Contains("ImageName"),
+                             prism::io::LoadError);
+        CHECK_THROWS_AS(prism::write_image(folder.path / "no_extension", image), prism::io::LoadError);
+        CHECK(folder.entry_count() == 0);
+    }
+    SUBCASE("an existing file is replaced whole") {
+        const fs::path file = folder.path / "replace.png";
+        prism::write_image(file, constant_image(5, 5, {1.0f, 2.0f, 3.0f}));
+        prism::write_image(file, image);
+        const prism::Image read = prism::read_image(file);
+        CHECK(read.width == 3);
+        CHECK(read.pixels[0] == glm::vec3(10.0f, 20.0f, 30.0f));
+        CHECK(folder.entry_count() == 1);
+    }
+}
