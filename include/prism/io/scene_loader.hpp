@@ -1,0 +1,726 @@
+// The one interpreter of CENG795 scene files (all schema years, XML and JSON alike): element tree
+// -> scene::Scene, with every id resolved and every fault reported as a LoadError naming the
+// element. Conventions it settles for the renderer:
+//   - Transformations are applied in the order written: `r1 t3` is first r1, then t3 (M = T3 R1).
+//   - Cameras come out in the Gaze + NearPlane form: lookAt cameras get gaze = GazePoint - Position
+//     and a symmetric near plane from FovY (the full vertical angle); camera transformations move
+//     Position as a point, Gaze and Up as directions.
+//   - Mesh instances carry their whole transform (the instance's own, after the base mesh's unless
+//     resetTransform="true") and their material (their own, else the base's).
+//   - Elements of later topics are skipped and named once each in Scene::unsupported.
+#pragma once
+
+#include <prism/io/element.hpp>
+#include <prism/io/load_error.hpp>
+#include <prism/io/ply.hpp>
+#include <prism/math/transform.hpp>
+#include <prism/scene/scene.hpp>
+
+#include <glm/glm.hpp>
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+#include <filesystem>
+#include <initializer_list>
+#include <limits>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <unordered_map>
+#include <vector>
+
+namespace prism::io {
+
+namespace detail::scene_loader {
+
+inline std::vector<std::string_view> split_words(std::string_view text) {
+    std::vector<std::string_view> words;
+    std::size_t i = 0;
+    while (i < text.size()) {
+        while (i < text.size() && Element::is_blank(text[i])) ++i;
+        const std::size_t start = i;
+        while (i < text.size() && !Element::is_blank(text[i])) ++i;
+        if (i > start) words.push_back(text.substr(start, i - start));
+    }
+    return words;
+}
+
+inline std::string_view trim(std::string_view text) {
+    while (!text.empty() && Element::is_blank(text.front())) text.remove_prefix(1);
+    while (!text.empty() && Element::is_blank(text.back())) text.remove_suffix(1);
+    return text;
+}
+
+inline std::string in_quotes(std::string_view text) { return "\"" + std::string(text) + "\""; }
+
+class Interpreter {
+public:
+    explicit Interpreter(const std::filesystem::path& file) : file_(file), folder_(file.parent_path()) {}
+
+    scene::Scene interpret(const Element& root) {
+        if (root.name != "Scene") fail(root, "the root element must be <Scene>, not <" + root.name + ">");
+        scene_.source = file_;
+        // Definitions first, wherever the file puts them: objects and cameras refer to them.
+        check_single(root, {"BackgroundColor", "ShadowRayEpsilon", "IntersectionTestEpsilon", "MaxRecursionDepth",
+                            "VertexData", "TexCoordData"});
+        for (const Element& child : root.children) {
+            if (child.name == "VertexData") read_vertex_data(child);
+            else if (child.name == "TexCoordData") read_texture_coordinates(child);
+            else if (child.name == "Transformations") read_transformations(child);
+            else if (child.name == "Materials") read_materials(child);
+        }
+        for (const Element& child : root.children) {
+            const std::string& name = child.name;
+            if (name == "BackgroundColor") scene_.background_color = vector3(child);
+            else if (name == "ShadowRayEpsilon") scene_.shadow_ray_epsilon = non_negative(child);
+            else if (name == "IntersectionTestEpsilon") scene_.intersection_test_epsilon = non_negative(child);
+            else if (name == "MaxRecursionDepth") scene_.max_recursion_depth = int(integer_at_least(child, 0));
+            else if (name == "Camera") read_camera(child);  // 2017: cameras directly under <Scene>
+            else if (name == "Cameras") read_cameras(child);
+            else if (name == "Lights") read_lights(child);
+            else if (name == "Objects") read_objects(child);
+            else if (name != "VertexData" && name != "TexCoordData" && name != "Transformations" && name != "Materials")
+                note_unsupported(child);
+        }
+        return std::move(scene_);
+    }
+
+private:
+    // ---- faults -----------------------------------------------------------------------------
+
+    [[noreturn]] void fail(const Element& element, const std::string& message) const {
+        throw LoadError(file_, element.where(), message);
+    }
+
+    const Element& required(const Element& parent, std::string_view name) const {
+        const Element* child = parent.child(name);
+        if (child == nullptr) fail(parent, "missing <" + std::string(name) + ">");
+        return *child;
+    }
+
+    const std::string& required_attribute(const Element& element, std::string_view name) const {
+        const std::string* value = element.attribute(name);
+        if (value == nullptr) fail(element, "missing attribute " + std::string(name));
+        return *value;
+    }
+
+    void check_single(const Element& parent, std::initializer_list<std::string_view> names) const {
+        for (std::string_view name : names) {
+            const auto count = std::count_if(parent.children.begin(), parent.children.end(),
+                                             [&](const Element& c) { return c.name == name; });
+            if (count > 1) fail(parent, "<" + std::string(name) + "> is given " + std::to_string(count) + " times");
+        }
+    }
+
+    // Later topics' elements are skipped, but named, so the renderer can say what it leaves out.
+    void note_unsupported(const Element& element) {
+        if (element.is_empty()) return;  // `<Textures></Textures>` asks for nothing
+        if (unsupported_seen_.insert(element.name).second) scene_.unsupported.push_back(element.name);
+    }
+
+    void note_unsupported_children(const Element& parent, std::initializer_list<std::string_view> known) {
+        for (const Element& child : parent.children)
+            if (std::find(known.begin(), known.end(), child.name) == known.end()) note_unsupported(child);
+    }
+
+    // ---- values -----------------------------------------------------------------------------
+
+    double parse_number(const Element& element, std::string_view word) const {
+        std::string_view digits = word;
+        if (digits.size() > 1 && digits.front() == '+') digits.remove_prefix(1);  // from_chars refuses '+'
+        double value = 0.0;
+        const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+        if (error == std::errc::result_out_of_range) fail(element, in_quotes(word) + " is out of the range of a double");
+        if (error != std::errc() || end != digits.data() + digits.size())
+            fail(element, in_quotes(word) + " is not a number");
+        if (!std::isfinite(value)) fail(element, in_quotes(word) + " is not a finite number");
+        return value;
+    }
+
+    std::vector<double> numbers(const Element& element) const {
+        std::vector<double> values;
+        for (std::string_view word : split_words(element.text)) values.push_back(parse_number(element, word));
+        return values;
+    }
+
+    std::vector<double> numbers(const Element& element, std::size_t count) const {
+        std::vector<double> values = numbers(element);
+        if (values.size() != count)
+            fail(element, "expected " + std::to_string(count) + (count == 1 ? " number" : " numbers") + ", found " +
+                              std::to_string(values.size()));
+        return values;
+    }
+
+    double number(const Element& element) const { return numbers(element, 1)[0]; }
+
+    double non_negative(const Element& element) const {
+        const double value = number(element);
+        if (value < 0.0) fail(element, "must not be negative");
+        return value;
+    }
+
+    scene::Vec3 vector3(const Element& element) const {
+        const std::vector<double> v = numbers(element, 3);
+        return {v[0], v[1], v[2]};
+    }
+
+    // Integers may be written as such or as an integral number ("800", "8e2").
+    long long parse_integer(const Element& element, std::string_view word) const {
+        long long value = 0;
+        const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), value);
+        if (error == std::errc() && end == word.data() + word.size()) return value;
+        const double real = parse_number(element, word);
+        if (real != std::floor(real) || std::abs(real) > 9.0e15) fail(element, in_quotes(word) + " is not an integer");
+        return static_cast<long long>(real);
+    }
+
+    std::vector<long long> integers(const Element& element) const {
+        std::vector<long long> values;
+        for (std::string_view word : split_words(element.text)) values.push_back(parse_integer(element, word));
+        return values;
+    }
+
+    long long integer(const Element& element) const {
+        const std::vector<std::string_view> words = split_words(element.text);
+        if (words.size() != 1) fail(element, "expected 1 integer, found " + std::to_string(words.size()) + " values");
+        return parse_integer(element, words[0]);
+    }
+
+    long long integer_at_least(const Element& element, long long minimum) const {
+        const long long value = integer(element);
+        if (value < minimum) fail(element, "must be at least " + std::to_string(minimum) + ", not " + std::to_string(value));
+        return value;
+    }
+
+    long long integer_attribute(const Element& element, std::string_view name, long long fallback) const {
+        const std::string* value = element.attribute(name);
+        if (value == nullptr) return fallback;
+        const std::string_view word = trim(*value);
+        long long result = 0;
+        const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), result);
+        if (error != std::errc() || end != word.data() + word.size() || word.empty())
+            fail(element, "attribute " + std::string(name) + "=" + in_quotes(*value) + " is not an integer");
+        return result;
+    }
+
+    bool boolean_attribute(const Element& element, std::string_view name, bool fallback) const {
+        const std::string* value = element.attribute(name);
+        if (value == nullptr) return fallback;
+        const std::string_view word = trim(*value);
+        if (word == "true") return true;
+        if (word == "false") return false;
+        fail(element, "attribute " + std::string(name) + "=" + in_quotes(*value) + " must be \"true\" or \"false\"");
+    }
+
+    std::string text_of(const Element& element) const { return std::string(trim(element.text)); }
+
+    // ---- definitions ------------------------------------------------------------------------
+
+    void read_vertex_data(const Element& element) {
+        if (const std::string* type = element.attribute("type"); type != nullptr && trim(*type) != "xyz")
+            fail(element, "unsupported vertex data type " + in_quotes(*type) + " (expected \"xyz\")");
+        const std::vector<double> v = numbers(element);
+        if (v.size() % 3 != 0)
+            fail(element, std::to_string(v.size()) + " numbers do not make x y z triples");
+        vertices_.reserve(v.size() / 3);
+        for (std::size_t i = 0; i < v.size(); i += 3) vertices_.push_back({v[i], v[i + 1], v[i + 2]});
+    }
+
+    void read_texture_coordinates(const Element& element) {
+        const std::vector<double> v = numbers(element);
+        if (v.size() % 2 != 0) fail(element, std::to_string(v.size()) + " numbers do not make u v pairs");
+        texture_coordinates_.reserve(v.size() / 2);
+        for (std::size_t i = 0; i < v.size(); i += 2) texture_coordinates_.push_back({v[i], v[i + 1]});
+    }
+
+    void read_transformations(const Element& section) {
+        for (const Element& element : section.children) {
+            char kind = 0;
+            glm::dmat4 matrix(1.0);
+            if (element.name == "Translation") {
+                kind = 't';
+                matrix = translation(vector3(element));
+            } else if (element.name == "Scaling") {
+                kind = 's';
+                matrix = scaling(vector3(element));
+            } else if (element.name == "Rotation") {
+                kind = 'r';
+                const std::vector<double> v = numbers(element, 4);  // angle in degrees, then the axis
+                const glm::dvec3 axis{v[1], v[2], v[3]};
+                if (glm::length(axis) == 0.0) fail(element, "the rotation axis is zero");
+                matrix = rotation(v[0], axis);
+            } else if (element.name == "Composite") {
+                kind = 'c';
+                const std::vector<double> v = numbers(element, 16);
+                std::array<double, 16> rows{};
+                std::copy(v.begin(), v.end(), rows.begin());
+                matrix = composite_from_row_major(rows);
+            } else {
+                note_unsupported(element);
+                continue;
+            }
+            const std::string key = kind + required_id(element);
+            if (!transformations_.emplace(key, matrix).second)
+                fail(element, "a <" + element.name + "> with this id is already defined");
+        }
+    }
+
+    std::string required_id(const Element& element) const {
+        return std::string(trim(required_attribute(element, "id")));
+    }
+
+    // `<Transformations>s1 t2 r1</Transformations>`: applied in the order written.
+    glm::dmat4 transformation_of(const Element& object) const {
+        glm::dmat4 matrix(1.0);
+        const Element* references = object.child("Transformations");
+        if (references == nullptr) return matrix;
+        for (std::string_view word : split_words(references->text)) {
+            const char kind = word.front();
+            if (kind != 't' && kind != 's' && kind != 'r' && kind != 'c')
+                fail(*references, "unknown transformation kind '" + std::string(1, kind) + "' in " + in_quotes(word) +
+                                      " (expected t, s, r or c followed by an id)");
+            const auto found = transformations_.find(std::string(word));
+            if (found == transformations_.end()) {
+                const char* kinds[] = {"Translation", "Scaling", "Rotation", "Composite"};
+                const char* kind_name = kinds[kind == 't' ? 0 : kind == 's' ? 1 : kind == 'r' ? 2 : 3];
+                fail(*references, "unknown transformation " + in_quotes(word) + ": no <" + kind_name + " id=" +
+                                      in_quotes(word.substr(1)) + ">");
+            }
+            matrix = found->second * matrix;
+        }
+        return matrix;
+    }
+
+    void read_materials(const Element& section) {
+        for (const Element& element : section.children) {
+            if (element.name != "Material") {
+                note_unsupported(element);
+                continue;
+            }
+            scene::Material material;
+            material.id = required_id(element);
+            if (const Element* e = element.child("AmbientReflectance")) material.ambient = vector3(*e);
+            if (const Element* e = element.child("DiffuseReflectance")) material.diffuse = vector3(*e);
+            if (const Element* e = element.child("SpecularReflectance")) material.specular = vector3(*e);
+            if (const Element* e = element.child("MirrorReflectance")) material.mirror = vector3(*e);
+            if (const Element* e = element.child("PhongExponent")) material.phong_exponent = number(*e);
+            if (const Element* e = element.child("RefractionIndex")) material.refraction_index = number(*e);
+            if (const Element* e = element.child("AbsorptionIndex")) material.absorption_index = number(*e);
+            if (const Element* e = element.child("AbsorptionCoefficient")) material.absorption_coefficient = vector3(*e);
+            if (const Element* e = element.child("Transparency")) material.transparency = vector3(*e);
+            if (const Element* e = element.child("Roughness")) material.roughness = non_negative(*e);
+            material.degamma = boolean_attribute(element, "degamma", false);
+
+            const std::string* type = element.attribute("type");
+            const std::string_view type_name = type != nullptr ? trim(*type) : std::string_view();
+            if (type_name == "mirror") {
+                material.type = scene::MaterialType::mirror;
+            } else if (type_name == "conductor") {
+                material.type = scene::MaterialType::conductor;
+            } else if (type_name == "dielectric") {
+                material.type = scene::MaterialType::dielectric;
+            } else if (type_name.empty()) {
+                // 2017-2019 schemas have no type: a mirror colour makes a mirror, a transparency
+                // colour glass (no file gives both).
+                if (material.mirror != scene::Vec3(0.0)) material.type = scene::MaterialType::mirror;
+                else if (material.transparency != scene::Vec3(0.0)) material.type = scene::MaterialType::dielectric;
+            } else {
+                fail(element, "unknown material type " + in_quotes(*type) + " (expected mirror, conductor or dielectric)");
+            }
+            note_unsupported_children(element, {"AmbientReflectance", "DiffuseReflectance", "SpecularReflectance",
+                                                "MirrorReflectance", "PhongExponent", "RefractionIndex",
+                                                "AbsorptionIndex", "AbsorptionCoefficient", "Transparency",
+                                                "Roughness"});
+            if (!material_indices_.emplace(material.id, scene_.materials.size()).second)
+                fail(element, "a <Material> with this id is already defined");
+            scene_.materials.push_back(std::move(material));
+        }
+    }
+
+    std::size_t material_of(const Element& reference) const {
+        const std::string id = text_of(reference);
+        const auto found = material_indices_.find(id);
+        if (found == material_indices_.end()) fail(reference, "unknown material id " + in_quotes(id));
+        return found->second;
+    }
+
+    // ---- cameras and lights -----------------------------------------------------------------
+
+    void read_cameras(const Element& section) {
+        for (const Element& element : section.children) {
+            if (element.name == "Camera") read_camera(element);
+            else note_unsupported(element);
+        }
+    }
+
+    void read_camera(const Element& element) {
+        scene::Camera camera;
+        if (const std::string* id = element.attribute("id")) camera.id = std::string(trim(*id));
+        const std::string* type = element.attribute("type");
+        const std::string_view type_name = type != nullptr ? trim(*type) : std::string_view();
+        if (!type_name.empty() && type_name != "lookAt" && type_name != "simple")
+            fail(element, "unknown camera type " + in_quotes(*type) + " (expected lookAt, or none)");
+        const bool look_at = type_name == "lookAt";
+
+        camera.position = vector3(required(element, "Position"));
+        camera.up = vector3(required(element, "Up"));
+
+        const Element& resolution = required(element, "ImageResolution");
+        const std::vector<long long> size = integers(resolution);
+        if (size.size() != 2) fail(resolution, "expected 2 integers (width height), found " + std::to_string(size.size()));
+        if (size[0] <= 0 || size[1] <= 0 || size[0] > std::numeric_limits<int>::max() ||
+            size[1] > std::numeric_limits<int>::max())
+            fail(resolution, "the image resolution must be positive, not " + std::to_string(size[0]) + " x " +
+                                 std::to_string(size[1]));
+        camera.width = int(size[0]);
+        camera.height = int(size[1]);
+
+        // The gaze is a point to look at (lookAt) or a direction. Some lookAt cameras of 2019-2022
+        // give a Gaze direction instead of a GazePoint, so each form falls back on the other.
+        const Element* gaze_point = element.child("GazePoint");
+        const Element* gaze = element.child("Gaze");
+        if (gaze_point != nullptr && (look_at || gaze == nullptr)) {
+            camera.gaze = vector3(*gaze_point) - camera.position;
+        } else if (gaze != nullptr) {
+            camera.gaze = vector3(*gaze);
+        } else {
+            fail(element, look_at ? "missing <GazePoint>" : "missing <Gaze>");
+        }
+
+        // The near plane is given by its edges (NearPlane: left right bottom top) or, for lookAt
+        // cameras, by the full vertical field of view FovY, centred, with the image's aspect.
+        // Before 2018 NearPlane could carry a fifth number, the near distance.
+        const Element* near_plane = element.child("NearPlane");
+        const Element* fov = element.child("FovY");
+        std::optional<double> near_distance;
+        std::vector<double> plane;
+        if (near_plane != nullptr && (!look_at || fov == nullptr)) {
+            plane = numbers(*near_plane);
+            if (plane.size() == 5) near_distance = plane[4];
+            else if (plane.size() != 4)
+                fail(*near_plane, "expected 4 numbers (left right bottom top), found " + std::to_string(plane.size()));
+        } else if (fov == nullptr) {
+            fail(element, look_at ? "missing <FovY>" : "missing <NearPlane>");
+        }
+        if (const Element* distance = element.child("NearDistance")) {
+            const double written = number(*distance);
+            if (near_distance && *near_distance != written)
+                fail(*distance, "the near distance differs from the fifth number of <NearPlane>");
+            near_distance = written;
+        }
+        if (!near_distance) fail(element, "missing <NearDistance>");
+        if (!(*near_distance > 0.0)) fail(element, "the near distance must be positive");
+        camera.near_distance = *near_distance;
+        if (!plane.empty()) {
+            camera.near_left = plane[0];
+            camera.near_right = plane[1];
+            camera.near_bottom = plane[2];
+            camera.near_top = plane[3];
+        } else {
+            const double fov_y = number(*fov);
+            if (!(fov_y > 0.0 && fov_y < 180.0)) fail(*fov, "FovY must be between 0 and 180 degrees");
+            camera.near_top = camera.near_distance * std::tan(glm::radians(fov_y) / 2.0);
+            camera.near_bottom = -camera.near_top;
+            camera.near_right = camera.near_top * double(camera.width) / double(camera.height);
+            camera.near_left = -camera.near_right;
+        }
+        if (camera.near_left == camera.near_right || camera.near_bottom == camera.near_top)
+            fail(plane.empty() ? *fov : *near_plane, "the near plane has no area");
+
+        camera.image_name = text_of(required(element, "ImageName"));
+        if (camera.image_name.empty()) fail(required(element, "ImageName"), "the image name is empty");
+        if (const Element* e = element.child("NumSamples")) camera.num_samples = int(integer_at_least(*e, 1));
+        if (const Element* e = element.child("ApertureSize")) camera.aperture_size = non_negative(*e);
+        if (const Element* e = element.child("FocusDistance")) camera.focus_distance = non_negative(*e);
+
+        if (const std::string* handedness = element.attribute("handedness")) {
+            const std::string_view hand = trim(*handedness);
+            if (hand == "left") camera.left_handed = true;
+            else if (hand != "right") fail(element, "handedness must be \"left\" or \"right\", not " + in_quotes(*handedness));
+        }
+
+        const glm::dmat4 transform = transformation_of(element);
+        camera.position = transform_point(transform, camera.position);
+        camera.gaze = transform_direction(transform, camera.gaze);
+        camera.up = transform_direction(transform, camera.up);
+        if (glm::length(camera.gaze) == 0.0) fail(element, "the gaze direction is zero");
+        if (glm::length(glm::cross(camera.gaze, camera.up)) == 0.0) fail(element, "Up is parallel to the gaze");
+
+        note_unsupported_children(element, {"Position", "Gaze", "GazePoint", "Up", "NearPlane", "NearDistance", "FovY",
+                                            "ImageResolution", "ImageName", "NumSamples", "ApertureSize",
+                                            "FocusDistance", "Transformations"});
+        scene_.cameras.push_back(std::move(camera));
+    }
+
+    void read_lights(const Element& section) {
+        for (const Element& element : section.children) {
+            if (element.name == "AmbientLight") {
+                scene_.ambient_light = vector3(element);
+            } else if (element.name == "PointLight") {
+                scene::PointLight light;
+                if (const std::string* id = element.attribute("id")) light.id = std::string(trim(*id));
+                light.position = transform_point(transformation_of(element), vector3(required(element, "Position")));
+                light.intensity = vector3(required(element, "Intensity"));
+                note_unsupported_children(element, {"Position", "Intensity", "Transformations"});
+                scene_.point_lights.push_back(std::move(light));
+            } else {
+                note_unsupported(element);
+            }
+        }
+    }
+
+    // ---- objects ----------------------------------------------------------------------------
+
+    // A 1-based index into VertexData, as Sphere's Center and Plane's Point give it.
+    scene::Vec3 vertex_of(const Element& reference) const {
+        const long long index = integer(reference);
+        if (index < 1 || std::size_t(index) > vertices_.size())
+            fail(reference, "vertex index " + std::to_string(index) + " is out of range: the VertexData holds " +
+                                std::to_string(vertices_.size()) + " vertices (indices start at 1)");
+        return vertices_[std::size_t(index - 1)];
+    }
+
+    scene::ShadingMode shading_of(const Element& element) const {
+        const std::string* mode = element.attribute("shadingMode");
+        if (mode == nullptr || trim(*mode) == "flat") return scene::ShadingMode::flat;
+        if (trim(*mode) == "smooth") return scene::ShadingMode::smooth;
+        fail(element, "shadingMode must be \"flat\" or \"smooth\", not " + in_quotes(*mode));
+    }
+
+    std::string id_of(const Element& element) const {
+        const std::string* id = element.attribute("id");
+        return id != nullptr ? std::string(trim(*id)) : std::string();
+    }
+
+    // Builds one mesh's own vertex list from global indices: each global vertex (with its
+    // texture coordinate, when the scene has them) becomes one local vertex, so faces that share a
+    // vertex in the file share it in the mesh.
+    struct MeshBuilder {
+        scene::Mesh& mesh;
+        std::unordered_map<std::uint64_t, std::uint32_t> local_index{};
+    };
+
+    void add_indexed_faces(MeshBuilder& builder, const Element& element, const std::vector<long long>& indices,
+                           long long vertex_offset, long long texture_offset) const {
+        if (indices.size() % 3 != 0)
+            fail(element, std::to_string(indices.size()) + " vertex indices do not make triangles");
+        const bool with_uvs = !texture_coordinates_.empty();
+        const auto local = [&](long long written) -> std::uint32_t {
+            const long long vertex = written + vertex_offset;
+            if (vertex < 1 || std::size_t(vertex) > vertices_.size())
+                fail(element, "vertex index " + std::to_string(vertex) +
+                                  (vertex_offset != 0 ? " (" + std::to_string(written) + " + vertexOffset " +
+                                                            std::to_string(vertex_offset) + ")"
+                                                      : std::string()) +
+                                  " is out of range: the VertexData holds " + std::to_string(vertices_.size()) +
+                                  " vertices (indices start at 1)");
+            const long long uv = written + texture_offset;
+            if (with_uvs && (uv < 1 || std::size_t(uv) > texture_coordinates_.size()))
+                fail(element, "texture coordinate index " + std::to_string(uv) +
+                                  " is out of range: the TexCoordData holds " +
+                                  std::to_string(texture_coordinates_.size()) + " pairs");
+            const std::uint64_t key = with_uvs ? (std::uint64_t(vertex) << 32) | std::uint64_t(uv) : std::uint64_t(vertex);
+            const auto [found, added] = builder.local_index.emplace(key, std::uint32_t(builder.mesh.positions.size()));
+            if (added) {
+                builder.mesh.positions.push_back(vertices_[std::size_t(vertex - 1)]);
+                if (with_uvs) builder.mesh.uvs.push_back(texture_coordinates_[std::size_t(uv - 1)]);
+            }
+            return found->second;
+        };
+        for (std::size_t i = 0; i < indices.size(); i += 3)
+            builder.mesh.triangles.push_back({local(indices[i]), local(indices[i + 1]), local(indices[i + 2])});
+    }
+
+    void add_ply_faces(scene::Mesh& mesh, const Element& faces, const std::string& ply_name) const {
+        PlyMesh ply;
+        try {
+            ply = read_ply(folder_ / ply_name);
+        } catch (const LoadError& error) {
+            // The PLY reader's message names the PLY file; this adds which scene element asked for it.
+            throw LoadError(file_, faces.where(), error.what());
+        } catch (const std::exception& error) {
+            throw LoadError(file_, faces.where(), (folder_ / ply_name).string() + ": " + error.what());
+        }
+        const std::size_t base = mesh.positions.size();
+        for (const auto& triangle : ply.triangles)
+            for (std::uint32_t index : triangle)
+                if (index >= ply.positions.size())
+                    fail(faces, (folder_ / ply_name).string() + ": a face uses vertex " + std::to_string(index) +
+                                    " of " + std::to_string(ply.positions.size()));
+        // A mesh built from several Faces keeps normals or uvs only if every part has them;
+        // read_objects drops partial ones.
+        mesh.positions.insert(mesh.positions.end(), ply.positions.begin(), ply.positions.end());
+        if (ply.normals.size() == ply.positions.size() && mesh.normals.size() == base)
+            mesh.normals.insert(mesh.normals.end(), ply.normals.begin(), ply.normals.end());
+        if (ply.uvs.size() == ply.positions.size() && mesh.uvs.size() == base)
+            mesh.uvs.insert(mesh.uvs.end(), ply.uvs.begin(), ply.uvs.end());
+        for (const auto& triangle : ply.triangles)
+            mesh.triangles.push_back({std::uint32_t(triangle[0] + base), std::uint32_t(triangle[1] + base),
+                                      std::uint32_t(triangle[2] + base)});
+    }
+
+    void read_mesh(const Element& element) {
+        scene::Mesh mesh;
+        mesh.id = id_of(element);
+        mesh.shading = shading_of(element);
+        mesh.material = material_of(required(element, "Material"));
+        mesh.transform = transformation_of(element);
+        MeshBuilder builder{mesh};
+        bool has_faces = false;
+        for (const Element& faces : element.children) {
+            if (faces.name != "Faces") continue;
+            has_faces = true;
+            if (const std::string* type = faces.attribute("type"); type != nullptr && trim(*type) != "triangle")
+                fail(faces, "unsupported face type " + in_quotes(*type) + " (expected \"triangle\")");
+            if (const std::string* ply = faces.attribute("plyFile")) {
+                add_ply_faces(mesh, faces, std::string(trim(*ply)));
+            } else {
+                add_indexed_faces(builder, faces, integers(faces), integer_attribute(faces, "vertexOffset", 0),
+                                  integer_attribute(faces, "textureOffset", 0));
+            }
+        }
+        if (!has_faces) fail(element, "missing <Faces>");
+        finish_mesh(mesh);
+        note_unsupported_children(element, {"Material", "Transformations", "Faces"});
+        if (!mesh_indices_.emplace(mesh.id, scene_.meshes.size()).second) ambiguous_mesh_ids_.insert(mesh.id);
+        scene_.meshes.push_back(std::move(mesh));
+    }
+
+    // A Triangle is a mesh of one face.
+    void read_triangle(const Element& element) {
+        scene::Mesh mesh;
+        mesh.id = id_of(element);
+        mesh.shading = shading_of(element);
+        mesh.material = material_of(required(element, "Material"));
+        mesh.transform = transformation_of(element);
+        const Element& indices = required(element, "Indices");
+        const std::vector<long long> corners = integers(indices);
+        if (corners.size() != 3) fail(indices, "expected 3 vertex indices, found " + std::to_string(corners.size()));
+        MeshBuilder builder{mesh};
+        add_indexed_faces(builder, indices, corners, 0, 0);
+        finish_mesh(mesh);
+        note_unsupported_children(element, {"Material", "Transformations", "Indices"});
+        scene_.meshes.push_back(std::move(mesh));
+    }
+
+    static void finish_mesh(scene::Mesh& mesh) {
+        if (mesh.normals.size() != mesh.positions.size()) mesh.normals.clear();
+        if (mesh.uvs.size() != mesh.positions.size()) mesh.uvs.clear();
+    }
+
+    void read_sphere(const Element& element) {
+        scene::Sphere sphere;
+        sphere.id = id_of(element);
+        sphere.material = material_of(required(element, "Material"));
+        sphere.transform = transformation_of(element);
+        sphere.center = vertex_of(required(element, "Center"));
+        const Element& radius = required(element, "Radius");
+        sphere.radius = number(radius);
+        if (!(sphere.radius > 0.0)) fail(radius, "the radius must be positive");
+        note_unsupported_children(element, {"Material", "Transformations", "Center", "Radius"});
+        scene_.spheres.push_back(std::move(sphere));
+    }
+
+    void read_plane(const Element& element) {
+        scene::Plane plane;
+        plane.id = id_of(element);
+        plane.material = material_of(required(element, "Material"));
+        plane.transform = transformation_of(element);
+        plane.point = vertex_of(required(element, "Point"));
+        const Element& normal = required(element, "Normal");
+        plane.normal = vector3(normal);
+        if (glm::length(plane.normal) == 0.0) fail(normal, "the normal is zero");
+        note_unsupported_children(element, {"Material", "Transformations", "Point", "Normal"});
+        scene_.planes.push_back(std::move(plane));
+    }
+
+    void read_objects(const Element& section) {
+        std::vector<const Element*> instances;
+        for (const Element& element : section.children) {
+            if (element.name == "Mesh") read_mesh(element);
+            else if (element.name == "Triangle") read_triangle(element);
+            else if (element.name == "Sphere") read_sphere(element);
+            else if (element.name == "Plane") read_plane(element);
+            else if (element.name == "MeshInstance") instances.push_back(&element);
+            else note_unsupported(element);
+        }
+        // After every mesh, since an instance may name a mesh written after it.
+        read_instances(instances);
+    }
+
+    void read_instances(const std::vector<const Element*>& elements) {
+        enum class State { waiting, resolving, done };
+        std::vector<State> state(elements.size(), State::waiting);
+        std::vector<scene::MeshInstance> instances(elements.size());
+        std::map<std::string, std::size_t> instance_indices;
+        std::set<std::string> ambiguous_instance_ids;
+        for (std::size_t i = 0; i < elements.size(); ++i)
+            if (!instance_indices.emplace(id_of(*elements[i]), i).second) ambiguous_instance_ids.insert(id_of(*elements[i]));
+
+        // baseMeshId names a Mesh; should it name another MeshInstance, the instance resolves to
+        // that instance's mesh, after that instance's transform.
+        const auto resolve = [&](auto& self, std::size_t i) -> void {
+            if (state[i] == State::done) return;
+            const Element& element = *elements[i];
+            if (state[i] == State::resolving) fail(element, "the instances' baseMeshId references form a cycle");
+            state[i] = State::resolving;
+            scene::MeshInstance& instance = instances[i];
+            instance.id = id_of(element);
+            const std::string base_id(trim(required_attribute(element, "baseMeshId")));
+            glm::dmat4 base_transform(1.0);
+            std::size_t base_material = 0;
+            if (const auto mesh = mesh_indices_.find(base_id); mesh != mesh_indices_.end()) {
+                if (ambiguous_mesh_ids_.count(base_id) != 0)
+                    fail(element, "baseMeshId " + in_quotes(base_id) + " is ambiguous: several meshes have this id");
+                instance.base_mesh = mesh->second;
+                base_transform = scene_.meshes[mesh->second].transform;
+                base_material = scene_.meshes[mesh->second].material;
+            } else if (const auto other = instance_indices.find(base_id); other != instance_indices.end()) {
+                if (ambiguous_instance_ids.count(base_id) != 0)
+                    fail(element, "baseMeshId " + in_quotes(base_id) + " is ambiguous: several instances have this id");
+                self(self, other->second);
+                instance.base_mesh = instances[other->second].base_mesh;
+                base_transform = instances[other->second].transform;
+                base_material = instances[other->second].material;
+            } else {
+                fail(element, "unknown baseMeshId " + in_quotes(base_id) + ": no <Mesh> has this id");
+            }
+            const glm::dmat4 own = transformation_of(element);
+            instance.transform = boolean_attribute(element, "resetTransform", false) ? own : own * base_transform;
+            const Element* material = element.child("Material");
+            instance.material = material != nullptr ? material_of(*material) : base_material;
+            note_unsupported_children(element, {"Material", "Transformations"});
+            state[i] = State::done;
+        };
+        for (std::size_t i = 0; i < elements.size(); ++i) resolve(resolve, i);
+        for (scene::MeshInstance& instance : instances) scene_.mesh_instances.push_back(std::move(instance));
+    }
+
+    std::filesystem::path file_;
+    std::filesystem::path folder_;  // PLY files are named relative to the scene file
+    scene::Scene scene_;
+    std::vector<scene::Vec3> vertices_;
+    std::vector<scene::Vec2> texture_coordinates_;
+    std::map<std::string, glm::dmat4> transformations_;  // key: kind letter and id, as referenced ("t1")
+    std::map<std::string, std::size_t> material_indices_;
+    std::map<std::string, std::size_t> mesh_indices_;     // ids of Mesh elements only
+    std::set<std::string> ambiguous_mesh_ids_;
+    std::set<std::string> unsupported_seen_;
+};
+
+}  // namespace detail::scene_loader
+
+// Interprets a scene file's element tree; `file` names the file in messages and locates PLYs.
+inline scene::Scene interpret_scene(const Element& root, const std::filesystem::path& file) {
+    return detail::scene_loader::Interpreter(file).interpret(root);
+}
+
+}  // namespace prism::io

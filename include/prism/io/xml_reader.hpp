@@ -1,0 +1,149 @@
+// Reads an XML scene file (pugixml) into the generic element tree, keeping each element's line
+// for messages. A malformed file is reported with pugixml's description, its line and column, and
+// the elements open at the fault, e.g. `<Objects>/<Mesh id="1"> (line 31, column 9)`.
+#pragma once
+
+#include <prism/io/element.hpp>
+#include <prism/io/load_error.hpp>
+
+#include <pugixml.hpp>
+
+#include <algorithm>
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace prism::io {
+
+namespace detail::xml {
+
+// Maps byte offsets to 1-based line numbers; pugixml only knows offsets.
+class LineTable {
+public:
+    explicit LineTable(std::string_view text) {
+        line_starts_.push_back(0);
+        for (std::size_t i = 0; i < text.size(); ++i)
+            if (text[i] == '\n') line_starts_.push_back(i + 1);
+    }
+    int line(std::ptrdiff_t offset) const {
+        if (offset < 0) return 0;
+        const auto next = std::upper_bound(line_starts_.begin(), line_starts_.end(), std::size_t(offset));
+        return int(next - line_starts_.begin());
+    }
+    int column(std::ptrdiff_t offset) const {
+        if (offset < 0) return 0;
+        return int(std::size_t(offset) - line_starts_[std::size_t(line(offset) - 1)]) + 1;
+    }
+
+private:
+    std::vector<std::size_t> line_starts_;
+};
+
+// The id attribute's value inside a start tag's text (`Mesh id="3" shadingMode="smooth"`).
+inline const std::string* find_id(std::string_view tag, std::string& storage) {
+    for (std::size_t at = tag.find("id"); at != std::string_view::npos; at = tag.find("id", at + 2)) {
+        if (at == 0 || !Element::is_blank(tag[at - 1])) continue;
+        std::size_t i = at + 2;
+        while (i < tag.size() && Element::is_blank(tag[i])) ++i;
+        if (i >= tag.size() || tag[i] != '=') continue;
+        ++i;
+        while (i < tag.size() && Element::is_blank(tag[i])) ++i;
+        if (i >= tag.size() || (tag[i] != '"' && tag[i] != '\'')) continue;
+        const std::size_t end = tag.find(tag[i], i + 1);
+        if (end == std::string_view::npos) return nullptr;
+        storage = std::string(tag.substr(i + 1, end - i - 1));
+        return &storage;
+    }
+    return nullptr;
+}
+
+// The path of the elements still open at `offset`, found by a small tag scanner: pugixml reports
+// where a malformed file goes wrong but not inside which element, which is what a user needs.
+inline std::string open_elements_at(std::string_view text, std::size_t offset) {
+    std::vector<std::string> open;
+    std::size_t i = 0;
+    const auto skip_past = [&](std::size_t from, std::string_view terminator) {
+        const std::size_t end = text.find(terminator, from);
+        return end == std::string_view::npos ? text.size() : end + terminator.size();
+    };
+    while (i < offset) {
+        const std::size_t start = text.find('<', i);
+        if (start == std::string_view::npos || start >= offset) break;
+        const std::string_view rest = text.substr(start);
+        if (rest.starts_with("<!--")) { i = skip_past(start + 4, "-->"); continue; }
+        if (rest.starts_with("<![CDATA[")) { i = skip_past(start + 9, "]]>"); continue; }
+        if (rest.starts_with("<?")) { i = skip_past(start + 2, "?>"); continue; }
+        if (rest.starts_with("<!")) { i = skip_past(start + 2, ">"); continue; }
+        std::size_t end = start + 1;
+        char quote = 0;
+        for (; end < text.size(); ++end) {
+            const char c = text[end];
+            if (quote != 0) {
+                if (c == quote) quote = 0;
+            } else if (c == '"' || c == '\'') {
+                quote = c;
+            } else if (c == '>' || c == '<') {
+                break;
+            }
+        }
+        // A tag that does not close before the fault is where the fault is: its parents are open.
+        if (end >= text.size() || text[end] != '>' || end >= offset) break;
+        const std::string_view tag = text.substr(start + 1, end - start - 1);
+        if (tag.starts_with('/')) {
+            if (!open.empty()) open.pop_back();
+        } else if (!tag.ends_with('/')) {
+            std::size_t name_end = 0;
+            while (name_end < tag.size() && !Element::is_blank(tag[name_end]) && tag[name_end] != '/') ++name_end;
+            std::string id;
+            open.push_back(element_label(tag.substr(0, name_end), find_id(tag, id)));
+        }
+        i = end + 1;
+    }
+    // Paths leave the root out (see assign_paths), unless it is all there is.
+    if (open.size() == 1) return open.front();
+    std::string path;
+    for (std::size_t k = 1; k < open.size(); ++k) path += (k > 1 ? "/" : "") + open[k];
+    return path;
+}
+
+inline Element convert(const pugi::xml_node& node, const LineTable& lines) {
+    Element element;
+    element.name = node.name();
+    element.line = lines.line(node.offset_debug());
+    for (const pugi::xml_attribute& attribute : node.attributes())
+        element.attributes.emplace_back(attribute.name(), attribute.value());
+    for (const pugi::xml_node& child : node.children()) {
+        if (child.type() == pugi::node_element) {
+            element.children.push_back(convert(child, lines));
+        } else if (child.type() == pugi::node_pcdata || child.type() == pugi::node_cdata) {
+            // Text split by a comment (`1 2 <!-- -->3`) must not glue two numbers together.
+            if (!element.text.empty()) element.text += ' ';
+            element.text += child.value();
+        }
+    }
+    return element;
+}
+
+}  // namespace detail::xml
+
+inline Element read_xml(const std::filesystem::path& path) {
+    const std::string contents = read_text_file(path);
+    const detail::xml::LineTable lines(contents);
+    pugi::xml_document document;
+    const pugi::xml_parse_result result = document.load_buffer(contents.data(), contents.size());
+    if (!result) {
+        std::string where = detail::xml::open_elements_at(contents, std::size_t(result.offset));
+        where += (where.empty() ? "(line " : " (line ") + std::to_string(lines.line(result.offset)) +
+                 ", column " + std::to_string(lines.column(result.offset)) + ")";
+        throw LoadError(path, where, std::string("malformed XML: ") + result.description());
+    }
+    const pugi::xml_node root = document.document_element();
+    if (!root) throw LoadError(path, "", "the file holds no XML element");
+    Element tree = detail::xml::convert(root, lines);
+    assign_paths(tree);
+    return tree;
+}
+
+}  // namespace prism::io

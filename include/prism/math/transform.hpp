@@ -1,0 +1,67 @@
+// 4x4 affine transforms as the course's scene files write them (Translation, Scaling, Rotation
+// by an angle in degrees about an axis, Composite given row-major), built in double precision,
+// and the three ways to apply one: to points, to directions, and to normals (inverse transpose).
+// Matrices are GLM's: column-major storage, applied to column vectors (p' = M p), so "first A,
+// then B" is the product B * A.
+#pragma once
+
+#include <prism/math/vector.hpp>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <array>
+
+namespace prism {
+
+inline glm::dmat4 translation(const glm::dvec3& offset) { return glm::translate(glm::dmat4(1.0), offset); }
+
+inline glm::dmat4 scaling(const glm::dvec3& factors) { return glm::scale(glm::dmat4(1.0), factors); }
+
+// Counter-clockwise about `axis` (right-handed) by `angle_degrees`; the axis need not be unit
+// length but must not be zero.
+inline glm::dmat4 rotation(double angle_degrees, const glm::dvec3& axis) {
+    return glm::rotate(glm::dmat4(1.0), glm::radians(angle_degrees), glm::normalize(axis));
+}
+
+// The course writes a Composite's 16 numbers row by row; GLM indexes matrix[column][row].
+inline glm::dmat4 composite_from_row_major(const std::array<double, 16>& rows) {
+    glm::dmat4 matrix(1.0);
+    for (int row = 0; row < 4; ++row)
+        for (int column = 0; column < 4; ++column) matrix[column][row] = rows[std::size_t(row * 4 + column)];
+    return matrix;
+}
+
+// The transforms are affine, so the homogeneous coordinate stays 1 and needs no division.
+template <Scalar Real>
+Vec3<Real> transform_point(const Mat4<Real>& matrix, const Vec3<Real>& point) {
+    return Vec3<Real>(matrix * Vec4<Real>(point, Real(1)));
+}
+
+// Directions (gaze, up, ray directions, tangents) ignore the translation. Not renormalised: a
+// ray direction scaled with the object keeps its parameter t meaning the same distance.
+template <Scalar Real>
+Vec3<Real> transform_direction(const Mat4<Real>& matrix, const Vec3<Real>& direction) {
+    return Mat3<Real>(matrix) * direction;
+}
+
+// The inverse transpose of the upper 3x3: it keeps normals perpendicular to transformed tangents
+// under non-uniform scaling. Compute it once per object and apply it with transform_normal.
+template <Scalar Real>
+Mat3<Real> normal_matrix(const Mat4<Real>& matrix) {
+    return glm::transpose(glm::inverse(Mat3<Real>(matrix)));
+}
+
+// Not renormalised, as the caller usually normalises after interpolation anyway.
+template <Scalar Real>
+Vec3<Real> transform_normal(const Mat3<Real>& inverse_transpose, const Vec3<Real>& normal) {
+    return inverse_transpose * normal;
+}
+
+// For one normal: inverts the matrix on every call.
+template <Scalar Real>
+Vec3<Real> transform_normal(const Mat4<Real>& matrix, const Vec3<Real>& normal) {
+    return normal_matrix(matrix) * normal;
+}
+
+}  // namespace prism
