@@ -1,4 +1,4 @@
-// Image files: the course's 8-bit conversion, writing PNG and EXR, reading PNG/JPG/BMP/TGA/PPM,
+// Image files: the course's 8-bit conversion, writing PNG, PPM and EXR, reading PNG/JPG/BMP/TGA/PPM,
 // Radiance .hdr and OpenEXR (scanline or tiled) into the HDR film. stb and tinyexr are compiled
 // in their system libraries (libstb, libtinyexr), so no *_IMPLEMENTATION macro is defined here.
 #pragma once
@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -110,15 +111,27 @@ inline std::string stb_failure() {
     return reason ? reason : "unknown reason";
 }
 
+// Binary PPM (P6), the output format of the course's 2017-2019 scenes (their cameras name
+// `.ppm` images): the same to_8bit bytes a PNG would hold, uncompressed.
+inline void write_ppm(const std::filesystem::path& path, const Image& image, const std::filesystem::path& shown) {
+    const std::vector<std::uint8_t> bytes = to_8bit(image);
+    std::ofstream out(path, std::ios::binary);
+    out << "P6\n" << image.width << ' ' << image.height << "\n255\n";
+    out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    out.close();
+    if (!out) throw io::LoadError(shown, "ImageName", "cannot write the PPM file");
+}
+
 }  // namespace detail
 
-// Writes `.png` (8-bit, to_8bit) or `.exr` (linear float RGB). Missing parent folders are
+// Writes `.png` or `.ppm` (8-bit, to_8bit) or `.exr` (linear float RGB). Missing parent folders are
 // created; the file appears whole or not at all (written to a temporary sibling, then renamed),
 // so a failed or interrupted write never leaves a truncated image that looks like a result.
 inline void write_image(const std::filesystem::path& path, const Image& image) {
     const std::string extension = detail::lowercase_extension(path);
-    if (extension != ".png" && extension != ".exr")
-        throw io::LoadError(path, "ImageName", "unsupported output format '" + extension + "' (use .png or .exr)");
+    if (extension != ".png" && extension != ".exr" && extension != ".ppm")
+        throw io::LoadError(path, "ImageName",
+                            "unsupported output format '" + extension + "' (use .png, .exr or .ppm)");
     if (image.width <= 0 || image.height <= 0 ||
         image.pixels.size() != std::size_t(image.width) * std::size_t(image.height))
         throw io::LoadError(path, "ImageName", "the image is empty or its size does not match its pixels");
@@ -134,6 +147,8 @@ inline void write_image(const std::filesystem::path& path, const Image& image) {
             const std::vector<std::uint8_t> bytes = to_8bit(image);
             if (!stbi_write_png(temporary.c_str(), image.width, image.height, 3, bytes.data(), image.width * 3))
                 throw io::LoadError(path, "ImageName", "cannot write the PNG file");
+        } else if (extension == ".ppm") {
+            detail::write_ppm(temporary, image, path);
         } else {
             detail::write_exr(temporary, image, path);
         }
