@@ -1,6 +1,7 @@
 // The generic element tree both scene formats are read into: name, attributes, text and children,
 // as in the XML files (the 2025 JSON files are a mechanical transliteration of them). The one
 // interpreter (scene_loader.hpp) reads this tree, so XML and JSON scenes mean the same thing.
+// Also the whole-file read both readers start from.
 #pragma once
 
 #include <prism/io/load_error.hpp>
