@@ -60,10 +60,10 @@ glm::dvec3 mean(const prism::Image& image) {
 
 }  // namespace
 
-TEST_CASE("to_8bit clamps to 0..255 and rounds to nearest") {
+TEST_CASE("to_8bit clamps to 0..255 and truncates, as the course does") {
     prism::Image image(4, 2);
     const float values[8] = {-5.0f, 0.49999997f, 0.5f, 1.49f, 127.5f, 254.6f, 255.0f, 1e9f};
-    const std::uint8_t expected[8] = {0, 0, 1, 1, 128, 255, 255, 255};
+    const std::uint8_t expected[8] = {0, 0, 0, 1, 127, 254, 255, 255};
     for (int i = 0; i < 8; ++i) image.pixels[std::size_t(i)] = glm::vec3(values[i]);
     image.pixels[0].g = std::numeric_limits<float>::quiet_NaN();
     const auto bytes = prism::to_8bit(image);

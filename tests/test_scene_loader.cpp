@@ -407,7 +407,7 @@ TEST_CASE("simple.xml: camera, light, material, a two-triangle mesh, a triangle 
     CHECK(near(scene.background_color, Vec3(0.0)));
     CHECK(scene.shadow_ray_epsilon == doctest::Approx(1e-3));
     CHECK(scene.intersection_test_epsilon == doctest::Approx(1e-6));
-    CHECK(scene.max_recursion_depth == 0);  // absent: the course's default
+    CHECK(scene.max_recursion_depth == 6);  // absent: the course's default
     CHECK(near(scene.ambient_light, Vec3(25.0)));
 
     REQUIRE(scene.cameras.size() == 1);
@@ -608,6 +608,22 @@ TEST_CASE("unsupported elements are named once each and skipped") {
     CHECK(scene.unsupported == std::vector<std::string>{"AreaLight", "LightSphere", "MotionBlur", "BRDFs"});
     CHECK(scene.spheres.size() == 1);
     CHECK(scene.point_lights.size() == 1);
+}
+
+TEST_CASE("the type attribute makes mirrors; an untyped Transparency makes glass") {
+    TemporaryFolder folder;
+    std::string xml = scene_xml(SceneParts{});
+    xml.replace(xml.find("</Materials>"), 0, R"(<Material id="3"><MirrorReflectance>0.5 0.5 0.5</MirrorReflectance></Material>
+        <Material id="4"><Transparency>0.9 0.9 0.9</Transparency><RefractionIndex>1.5</RefractionIndex></Material>
+        )");
+    const Scene scene = load_scene(folder.write("material_types.xml", xml));
+    REQUIRE(scene.materials.size() == 4);
+    CHECK(scene.materials[1].type == prism::scene::MaterialType::mirror);
+    // Untyped with a mirror colour: Blinn-Phong, as the course's images of such scenes show.
+    CHECK(scene.materials[2].type == prism::scene::MaterialType::blinn_phong);
+    CHECK(near(scene.materials[2].mirror, Vec3(0.5)));
+    CHECK(scene.materials[3].type == prism::scene::MaterialType::dielectric);
+    CHECK(near(scene.materials[3].transparency, Vec3(0.9)));
 }
 
 TEST_CASE("numbers in any course spelling parse; TexCoordData and vertexOffset reach the mesh") {

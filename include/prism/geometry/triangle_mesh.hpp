@@ -115,8 +115,10 @@ public:
     }
 
 private:
-    // Vertex normals as the course defines them: the normalised average of the unit normals of
-    // the faces that share the vertex. A PLY file's own normals take precedence.
+    // Vertex normals as the course's renderer computes them: the normalised sum of the faces'
+    // unnormalised normals, i.e. weighted by face area (with unit face normals instead,
+    // low_poly_smooth drops from 58 to 30 dB against the course's image). A PLY file's own
+    // normals take precedence.
     static std::vector<Vec3<Real>> smooth_normals(const scene::Mesh& mesh) {
         std::vector<Vec3<Real>> result(mesh.positions.size(), Vec3<Real>(0));
         if (mesh.normals.size() == mesh.positions.size()) {
@@ -125,11 +127,9 @@ private:
         }
         std::vector<glm::dvec3> sums(mesh.positions.size(), glm::dvec3(0.0));
         for (const auto& face : mesh.triangles) {
-            const glm::dvec3 n = glm::cross(mesh.positions[face[1]] - mesh.positions[face[0]],
-                                            mesh.positions[face[2]] - mesh.positions[face[0]]);
-            const double length = glm::length(n);
-            if (!(length > 0)) continue;
-            for (std::uint32_t v : face) sums[v] += n / length;
+            const glm::dvec3 area_weighted = glm::cross(mesh.positions[face[1]] - mesh.positions[face[0]],
+                                                        mesh.positions[face[2]] - mesh.positions[face[0]]);
+            for (std::uint32_t v : face) sums[v] += area_weighted;
         }
         for (std::size_t i = 0; i < sums.size(); ++i) {
             const double length = glm::length(sums[i]);
