@@ -43,8 +43,15 @@ public:
         // Shading uses the normal on the side the ray arrives from.
         const Vec3<Real> normal = front_face ? point.shading_normal : -point.shading_normal;
 
-        Vec3<Real> color = material.ambient * ambient_light_;
-        color += direct_lighting(point.position, normal, -d, material);
+        // A ray travelling inside a dielectric sees the interface from within, where no light
+        // reaches directly: the course shades only the outside (scienceTree_glass: 30.5 dB
+        // with inside shading, 58.5 dB without).
+        const bool inside_medium = !front_face && material.type == scene::MaterialType::dielectric;
+        Vec3<Real> color(0);
+        if (!inside_medium) {
+            color = material.ambient * ambient_light_;
+            color += direct_lighting(point.position, normal, -d, material);
+        }
 
         if (depth < settings_.max_recursion_depth) {
             using scene::MaterialType;
@@ -67,7 +74,7 @@ public:
         }
 
         // Beer's law: a ray that reached this surface from inside travelled hit.t through it.
-        if (!front_face && material.type == scene::MaterialType::dielectric) {
+        if (inside_medium) {
             const Vec3<Real> transmittance = glm::exp(-material.absorption_coefficient * hit.t);
             color *= transmittance;
         }
@@ -83,7 +90,15 @@ private:
             const LightSample<Real> sample = light.sample(position);
             const Real cos_light = glm::dot(normal, sample.direction);
             if (cos_light <= 0) return;
-            const Ray<Real> shadow{shadow_origin, sample.direction, Real(0), sample.distance};
+            // The shadow ray leaves the offset origin aimed at the light, and anything nearer than
+            // the light's distance from the shading point blocks it. So a surface through the
+            // light itself blocks it for every point, not by rounding (mirror_room's ceiling
+            // holds a light: 20.3 dB with a per-pixel coin flip, 64.5 dB consistent).
+            const Vec3<Real> shadow_direction =
+                std::isinf(sample.distance)
+                    ? sample.direction
+                    : glm::normalize(position + sample.direction * sample.distance - shadow_origin);
+            const Ray<Real> shadow{shadow_origin, shadow_direction, Real(0), sample.distance};
             if (geometry_.occluded(shadow)) return;
             const Vec3<Real> half_vector = glm::normalize(sample.direction + to_viewer);
             const Real cos_half = std::max(glm::dot(normal, half_vector), Real(0));
