@@ -3,8 +3,10 @@
 // the tests all come through here, so there is one way from a scene description to images.
 #pragma once
 
+#include <prism/geometry/double_refine.hpp>
 #include <prism/image/image.hpp>
 #include <prism/render/renderer.hpp>
+#include <prism/scene/features.hpp>
 #include <prism/scene/scene.hpp>
 
 #include <tbb/global_control.h>
@@ -55,9 +57,20 @@ struct Choice {
     std::string reason;
 };
 
-inline Choice choose_precision(const scene::Scene&, const RenderOptions& options) {
+// Float resolves 2^-24 of a coordinate. Triangles whose shortest edge spans at least 2^-12 of
+// their coordinates (4096 float ulps) lose nothing in float with watertight tests; between
+// 2^-16 and 2^-12 the triangle test moves to double (vertices kept in double); below 2^-16 a
+// float ray origin is no longer precise to a fraction of a triangle, so everything is double.
+inline Choice choose_precision(const scene::Scene& scene, const RenderOptions& options) {
     if (options.precision) return {*options.precision, "requested with --precision"};
-    return {Precision::single, "default: float traversal with watertight triangle tests"};
+    const scene::PrecisionFeatures features = scene::measure_precision(scene);
+    if (features.triangles_measured == 0) return {Precision::single, "no triangles: float suffices"};
+    const double size = features.relative_size_percentile_1;
+    const std::string measured = "the smallest triangles (1st percentile) span 2^" +
+                                 std::to_string(int(std::floor(std::log2(size)))) + " of their coordinates";
+    if (size >= 0x1p-12) return {Precision::single, measured + ", at least 2^-12: float"};
+    if (size >= 0x1p-16) return {Precision::double_refine, measured + ", below 2^-12: double-precision triangle tests"};
+    return {Precision::double_all, measured + ", below 2^-16: double throughout"};
 }
 
 namespace detail {
@@ -103,12 +116,15 @@ inline std::vector<CameraImage> render_scene(
     const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
     tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
     const Choice choice = choose_precision(scene, options);
-    log << "configuration: " << to_string(choice.precision) << ", BVH with watertight triangle tests, point lights ("
-        << choice.reason << ")\n";
+    static constexpr const char* geometry_of[] = {"float BVH, watertight triangle tests",
+                                                  "float BVH, double-precision watertight triangle tests",
+                                                  "double BVH, watertight triangle tests"};
+    log << "configuration: " << geometry_of[int(choice.precision)] << ", point lights (" << choice.reason << ")\n";
     switch (choice.precision) {
         case Precision::single:
             return detail::render_with<Config<float, Bvh<Watertight>, Lights<PointLight>>>(scene, options, log, on_tile);
         case Precision::double_refine:
+            return detail::render_with<Config<float, Bvh<DoubleRefine>, Lights<PointLight>>>(scene, options, log, on_tile);
         case Precision::double_all:
             return detail::render_with<Config<double, Bvh<Watertight>, Lights<PointLight>>>(scene, options, log, on_tile);
     }
