@@ -1,0 +1,759 @@
+// The BVH against brute force, for float and double: the closest hit (hit or miss, t, object,
+// triangle) and the any-hit query on 10^5 random rays over a course mesh with a sphere, and on
+// 10^4 rays over a procedural mesh with a transformed instance of it and a sphere, so the top
+// level is exercised too; then the tree's structure (every primitive in exactly one leaf,
+// children inside their parent, bounded depth), the degenerate inputs (no triangles, one
+// triangle, many triangles with one centroid, a geometric progression that drives the build to
+// its depth limit) and SceneGeometry's hit interval and back-face culling.
+#include <prism/accel/accelerator.hpp>
+#include <prism/geometry/scene_geometry.hpp>
+#include <prism/io/ply.hpp>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <doctest/doctest.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <random>
+#include <sstream>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#ifndef PRISM_SHARED_DIR
+#define PRISM_SHARED_DIR "../shared"
+#endif
+
+namespace {
+
+namespace scene = prism::scene;
+
+template <class Real>
+using BvhGeometry = prism::SceneGeometry<Real, prism::Bvh<prism::Watertight>>;
+template <class Real>
+using BruteGeometry = prism::SceneGeometry<Real, prism::BruteForce<prism::Watertight>>;
+
+// ---------------------------------------------------------------------------------------------
+// Scenes
+
+// The mesh is stored as a vertex soup in which every vertex of triangle i carries the texture
+// coordinate (i, 0): the interpolated u of a hit is then i, which names the triangle hit in the
+// scene's own numbering whatever order an index keeps its triangles in. The geometry is the
+// same as the shared-vertex mesh, vertex for vertex.
+scene::Mesh soup_with_triangle_ids(const std::vector<glm::dvec3>& positions,
+                                   const std::vector<std::array<std::uint32_t, 3>>& triangles) {
+    scene::Mesh mesh;
+    mesh.id = "under test";
+    for (std::size_t i = 0; i < triangles.size(); ++i) {
+        const auto first = std::uint32_t(mesh.positions.size());
+        for (std::uint32_t v : triangles[i]) {
+            mesh.positions.push_back(positions[v]);
+            mesh.uvs.push_back({double(i), 0.0});
+        }
+        mesh.triangles.push_back({first, first + 1, first + 2});
+    }
+    return mesh;
+}
+
+struct Bounds {
+    glm::dvec3 min{std::numeric_limits<double>::infinity()}, max{-std::numeric_limits<double>::infinity()};
+    glm::dvec3 centre() const { return (min + max) * 0.5; }
+    double radius() const { return glm::length(max - min) * 0.5; }
+};
+
+Bounds bounds_of(const std::vector<glm::dvec3>& positions) {
+    Bounds b;
+    for (const auto& p : positions) {
+        b.min = glm::min(b.min, p);
+        b.max = glm::max(b.max, p);
+    }
+    return b;
+}
+
+// Object 0: the mesh; with `with_instance`, object 1: the same mesh rotated, scaled and moved
+// by a third of its size (an instance sharing the mesh's index); last: a sphere in a corner of
+// the bounds, where the mesh does not hide it.
+scene::Scene mesh_scene(const scene::Mesh& mesh, const Bounds& bounds, bool with_instance) {
+    scene::Scene world;
+    world.materials.push_back({});
+    world.meshes.push_back(mesh);
+    const double r = bounds.radius();
+    world.spheres.push_back({"ball", 0, bounds.min + 0.1 * (bounds.max - bounds.min), 0.15 * r, glm::dmat4(1.0)});
+    if (!with_instance) return world;
+    glm::dmat4 transform(1.0);
+    transform = glm::translate(transform, bounds.centre() + glm::dvec3(0.3 * r, -0.2 * r, 0.25 * r));
+    transform = glm::rotate(transform, 0.7, glm::normalize(glm::dvec3(1, 2, 3)));
+    transform = glm::scale(transform, glm::dvec3(0.8, 1.1, 0.9));
+    transform = glm::translate(transform, -bounds.centre());
+    world.mesh_instances.push_back({"moved copy", 0, 0, transform});
+    return world;
+}
+
+// A unit icosphere subdivided `levels` times, every vertex moved radially by up to +-15%.
+void perturbed_sphere(int levels, std::uint32_t seed, std::vector<glm::dvec3>& positions,
+                      std::vector<std::array<std::uint32_t, 3>>& triangles) {
+    const double g = (1.0 + std::sqrt(5.0)) / 2.0;
+    positions = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
+                 {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+    for (auto& p : positions) p = glm::normalize(p);
+    triangles = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                 {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
+                 {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+    for (int level = 0; level < levels; ++level) {
+        std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> midpoints;
+        auto midpoint = [&](std::uint32_t a, std::uint32_t b) {
+            const auto key = std::minmax(a, b);
+            const auto found = midpoints.find(key);
+            if (found != midpoints.end()) return found->second;
+            positions.push_back(glm::normalize(positions[a] + positions[b]));
+            const auto index = std::uint32_t(positions.size() - 1);
+            midpoints.emplace(key, index);
+            return index;
+        };
+        std::vector<std::array<std::uint32_t, 3>> finer;
+        for (const auto& t : triangles) {
+            const std::uint32_t ab = midpoint(t[0], t[1]), bc = midpoint(t[1], t[2]), ca = midpoint(t[2], t[0]);
+            finer.push_back({t[0], ab, ca});
+            finer.push_back({t[1], bc, ab});
+            finer.push_back({t[2], ca, bc});
+            finer.push_back({ab, bc, ca});
+        }
+        triangles = std::move(finer);
+    }
+    std::mt19937 random(seed);
+    std::uniform_real_distribution<double> bump(0.85, 1.15);
+    for (auto& p : positions) p *= bump(random);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Rays
+
+std::vector<glm::dvec3> random_unit_vectors(std::mt19937& random, std::size_t count) {
+    std::normal_distribution<double> normal;
+    std::vector<glm::dvec3> result;
+    while (result.size() < count) {
+        const glm::dvec3 v(normal(random), normal(random), normal(random));
+        if (glm::length(v) > 1e-6) result.push_back(glm::normalize(v));
+    }
+    return result;
+}
+
+// Origins on a sphere around the bounds. 70% aim at random points inside the bounds (most hit),
+// 10% aim exactly at mesh vertices (where triangles share edges and the slab tests of flat
+// boxes are tight), 20% go in random directions.
+template <class Real>
+std::vector<prism::Ray<Real>> test_rays(const Bounds& bounds, const std::vector<glm::dvec3>& vertices,
+                                        std::size_t count, std::uint32_t seed) {
+    std::mt19937 random(seed);
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    const auto on_sphere = random_unit_vectors(random, count);
+    const auto directions = random_unit_vectors(random, count);
+    std::uniform_int_distribution<std::size_t> vertex(0, vertices.size() - 1);
+    std::vector<prism::Ray<Real>> rays;
+    rays.reserve(count);
+    for (std::size_t i = 0; i < count; ++i) {
+        const glm::dvec3 origin = bounds.centre() + 1.5 * bounds.radius() * on_sphere[i];
+        glm::dvec3 direction;
+        const double kind = uniform(random);
+        if (kind < 0.7) {
+            const glm::dvec3 target = bounds.min + glm::dvec3(uniform(random), uniform(random), uniform(random)) *
+                                                       (bounds.max - bounds.min);
+            direction = glm::normalize(target - origin);
+        } else if (kind < 0.8) {
+            direction = glm::normalize(vertices[vertex(random)] - origin);
+        } else {
+            direction = directions[i];
+        }
+        rays.push_back({prism::Vec3<Real>(origin), prism::Vec3<Real>(direction), Real(0), prism::infinity<Real>});
+    }
+    return rays;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Tracing and comparing
+
+template <class Real>
+struct Trace {
+    bool hit = false;
+    Real t = prism::infinity<Real>;
+    std::uint32_t object = 0;
+    long triangle = -1;  // from the texture coordinate; -1 for the sphere (the last object)
+    prism::Vec3<Real> normal{0};
+    bool t_max_lowered = true;  // intersect must leave ray.t_max at the hit distance
+    bool occluded_unbounded = false;
+    bool occluded_half = false;  // with t_max = half the brute-force distance
+};
+
+// Brute force costs a full scan per query, so its any-hit answers are computed on every
+// `any_hit_stride`-th ray only; the BVH's any-hit answers are checked on every ray against the
+// brute-force closest hit, which decides them.
+constexpr std::size_t any_hit_stride = 10;
+
+template <class Real, class Geometry>
+void trace_all(const Geometry& geometry, const std::vector<prism::Ray<Real>>& rays, std::size_t stride,
+               std::vector<Trace<Real>>& traces) {
+    const auto sphere = std::uint32_t(geometry.instance_count() - 1);
+    traces.resize(rays.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 64), [&](const auto& range) {
+        for (std::size_t i = range.begin(); i < range.end(); ++i) {
+            Trace<Real>& trace = traces[i];
+            prism::Ray<Real> ray = rays[i];
+            prism::Hit<Real> hit;
+            trace.hit = geometry.intersect(ray, hit);
+            if (trace.hit) {
+                trace.t = hit.t;
+                trace.t_max_lowered = ray.t_max == hit.t;
+                trace.object = hit.object;
+                const prism::SurfacePoint<Real> point = geometry.surface(ray, hit);
+                trace.normal = point.geometric_normal;
+                trace.triangle = hit.object == sphere ? -1 : std::lround(double(point.uv.x));
+            }
+            if (i % stride == 0) trace.occluded_unbounded = geometry.occluded(rays[i]);
+        }
+    });
+}
+
+// The any-hit query with t_max at half the reference distance: nothing can lie that close.
+template <class Real, class Geometry>
+void occluded_at_half(const Geometry& geometry, const std::vector<prism::Ray<Real>>& rays,
+                      const std::vector<Trace<Real>>& reference, std::size_t stride,
+                      std::vector<Trace<Real>>& traces) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 64), [&](const auto& range) {
+        for (std::size_t i = range.begin(); i < range.end(); ++i) {
+            if (!reference[i].hit || i % stride != 0) continue;
+            prism::Ray<Real> ray = rays[i];
+            ray.t_max = reference[i].t / 2;
+            traces[i].occluded_half = geometry.occluded(ray);
+        }
+    });
+}
+
+// The t that the watertight test gives for one triangle of the mesh or its instance (or the
+// sphere), with the ray taken to object space exactly as SceneGeometry does. Used to confirm
+// that two different answers are a genuine tie.
+template <class Real>
+bool direct_hit(const scene::Scene& world, const prism::Ray<Real>& world_ray, std::uint32_t object, long triangle,
+                Real& t) {
+    prism::Ray<Real> ray = world_ray;
+    const bool instance = !world.mesh_instances.empty() && object == 1;
+    if (instance) {
+        const glm::dmat4 inverse = glm::inverse(world.mesh_instances[0].transform);
+        const prism::Mat4<Real> to_object(inverse);
+        const prism::Mat3<Real> to_object_linear{glm::dmat3(inverse)};
+        ray = {prism::Vec3<Real>(to_object * prism::Vec4<Real>(ray.origin, 1)), to_object_linear * ray.direction,
+               ray.t_min, ray.t_max};
+    }
+    if (triangle < 0) {
+        const prism::SphereShape<Real> sphere{prism::Vec3<Real>(world.spheres[0].center), Real(world.spheres[0].radius)};
+        return sphere.intersect(ray, ray.t_min, prism::infinity<Real>, t);
+    }
+    const scene::Mesh& mesh = world.meshes[0];
+    const auto& face = mesh.triangles[std::size_t(triangle)];
+    prism::TriangleHit<Real> hit;
+    const prism::Watertight::Prepared<Real> prepared(ray);
+    if (!prism::Watertight::intersect(prepared, prism::Vec3<Real>(mesh.positions[face[0]]),
+                                      prism::Vec3<Real>(mesh.positions[face[1]]),
+                                      prism::Vec3<Real>(mesh.positions[face[2]]), ray.t_min, prism::infinity<Real>, hit))
+        return false;
+    t = hit.t;
+    return true;
+}
+
+template <class Real>
+std::string describe(const prism::Ray<Real>& ray, const Trace<Real>& bvh, const Trace<Real>& brute) {
+    std::ostringstream out;
+    out.precision(17);
+    out << "ray o=(" << ray.origin.x << ", " << ray.origin.y << ", " << ray.origin.z << ") d=(" << ray.direction.x << ", "
+        << ray.direction.y << ", " << ray.direction.z << "): bvh hit=" << bvh.hit << " t=" << bvh.t << " object="
+        << bvh.object << " triangle=" << bvh.triangle << " | brute hit=" << brute.hit << " t=" << brute.t
+        << " object=" << brute.object << " triangle=" << brute.triangle;
+    return out.str();
+}
+
+// Runs both geometries on the rays and counts every kind of disagreement; the first few are
+// printed so a failure can be reproduced.
+template <class Real>
+void compare_with_brute_force(const scene::Scene& world, const std::vector<prism::Ray<Real>>& rays) {
+    const BvhGeometry<Real> bvh(world);
+    const BruteGeometry<Real> brute(world);
+    const std::size_t copies = 1 + world.mesh_instances.size();
+    REQUIRE(bvh.instance_count() == copies + 1);
+    REQUIRE(bvh.triangle_count() == copies * world.meshes[0].triangles.size());
+    const std::size_t sphere = copies;
+
+    std::vector<Trace<Real>> bvh_traces, brute_traces;
+    trace_all(bvh, rays, 1, bvh_traces);
+    trace_all(brute, rays, any_hit_stride, brute_traces);
+    occluded_at_half(bvh, rays, brute_traces, 1, bvh_traces);
+    occluded_at_half(brute, rays, brute_traces, any_hit_stride, brute_traces);
+
+    std::size_t hits = 0, ties = 0, per_object[3] = {0, 0, 0};  // mesh, instance, sphere
+    std::size_t hit_mismatch = 0, t_mismatch = 0, identity_mismatch = 0, near_ties = 0, t_max_not_lowered = 0;
+    std::size_t occluded_mismatch = 0, brute_occluded_mismatch = 0;
+    int printed = 0;
+    auto report = [&](std::size_t i, const char* what) {
+        if (printed++ >= 4) return;
+        const std::string message = std::string(what) + ": " + describe(rays[i], bvh_traces[i], brute_traces[i]);
+        MESSAGE(message);
+    };
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        const Trace<Real>& a = bvh_traces[i];
+        const Trace<Real>& b = brute_traces[i];
+        if (!a.t_max_lowered || !b.t_max_lowered) ++t_max_not_lowered;
+        // Any hit: unbounded it is the closest hit's hit/miss; below half the closest distance
+        // there is nothing.
+        if (a.occluded_unbounded != b.hit || a.occluded_half) {
+            ++occluded_mismatch;
+            report(i, "bvh occluded");
+        }
+        if (i % any_hit_stride == 0 && (b.occluded_unbounded != b.hit || b.occluded_half)) {
+            ++brute_occluded_mismatch;
+            report(i, "brute-force occluded");
+        }
+        if (a.hit != b.hit) {
+            ++hit_mismatch;
+            report(i, "hit/miss");
+            continue;
+        }
+        if (!a.hit) continue;
+        ++hits;
+        ++per_object[b.object == sphere ? 2 : b.object];
+        const bool same_primitive = a.object == b.object && a.triangle == b.triangle;
+        if (same_primitive) {
+            // The same test on the same triangle and ray: t and normal must agree to the bit.
+            if (a.t != b.t || a.normal != b.normal) {
+                ++t_mismatch;
+                report(i, "same primitive, different t or normal");
+            }
+            continue;
+        }
+        // Different primitives: acceptable only as a tie, both genuinely hit at the same t.
+        Real t_a = -1, t_b = -1;
+        const bool real_a = direct_hit(world, rays[i], a.object, a.triangle, t_a);
+        const bool real_b = direct_hit(world, rays[i], b.object, b.triangle, t_b);
+        if (real_a && real_b && t_a == a.t && t_b == b.t && a.t == b.t) {
+            ++ties;
+        } else if (a.t == b.t) {
+            ++identity_mismatch;
+            report(i, "different primitive, not a genuine tie");
+        } else {
+            ++near_ties;
+            report(i, "different primitive at a different t");
+        }
+    }
+    MESSAGE(rays.size() << " rays: " << hits << " hits (mesh " << per_object[0] << ", instance " << per_object[1]
+                        << ", sphere " << per_object[2] << "), " << ties << " exact ties between triangles");
+    // The ray set must exercise what it claims to: most rays hit, some miss, every object is hit.
+    CHECK(hits > rays.size() / 2);
+    CHECK(hits < rays.size());
+    CHECK(per_object[0] > rays.size() / 20);
+    if (copies == 2) CHECK(per_object[1] > rays.size() / 20);
+    CHECK(per_object[2] > rays.size() / 100);
+
+    CHECK(hit_mismatch == 0);
+    CHECK(t_mismatch == 0);
+    CHECK(identity_mismatch == 0);
+    CHECK(near_ties == 0);
+    CHECK(t_max_not_lowered == 0);
+    CHECK(occluded_mismatch == 0);
+    CHECK(brute_occluded_mismatch == 0);
+}
+
+
+}  // namespace
+
+// 10^5 rays against 2,880 triangles and a sphere, brute force included, stay within a few
+// seconds on two cores; a larger course mesh would make the brute-force reference the bottleneck.
+TEST_CASE_TEMPLATE("BVH closest hit and any hit equal brute force on a course mesh", Real, float, double) {
+    const std::filesystem::path path = std::filesystem::path(PRISM_SHARED_DIR) /
+                                       "ceng795/hw4/2022F_Batucan2601/hw4/inputs/veach_ajar/models/Mesh015_fixed.ply";
+    if (!std::filesystem::exists(path)) {
+        MESSAGE("skipped: " << path.string() << " not found (set PRISM_SHARED_DIR)");
+        return;
+    }
+    const prism::io::PlyMesh ply = prism::io::read_ply(path);
+    REQUIRE(ply.triangles.size() == 2880);
+    const Bounds bounds = bounds_of(ply.positions);
+    const scene::Scene world = mesh_scene(soup_with_triangle_ids(ply.positions, ply.triangles), bounds, false);
+    compare_with_brute_force(world, test_rays<Real>(bounds, ply.positions, 100'000, 2013));
+}
+
+TEST_CASE_TEMPLATE("BVH closest hit and any hit equal brute force on a perturbed icosphere", Real, float, double) {
+    std::vector<glm::dvec3> positions;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    perturbed_sphere(4, 7, positions, triangles);
+    REQUIRE(triangles.size() == 5120);
+    const Bounds bounds = bounds_of(positions);
+    // The instance adds the transformed object space and the top-level index to the comparison.
+    const scene::Scene world = mesh_scene(soup_with_triangle_ids(positions, triangles), bounds, true);
+    compare_with_brute_force(world, test_rays<Real>(bounds, positions, 10'000, 1980));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The tree's structure
+
+namespace {
+
+template <class Real>
+bool contains(const prism::Aabb<Real>& outer, const prism::Aabb<Real>& inner) {
+    return glm::all(glm::lessThanEqual(outer.min, inner.min)) && glm::all(glm::lessThanEqual(inner.max, outer.max));
+}
+
+// Every primitive in exactly one leaf, every node reached exactly once from the root, children
+// inside their parent, leaves around their primitives, depth within the traversal stack.
+template <class Real>
+void check_structure(const prism::BvhTree<Real>& tree, const std::vector<prism::Aabb<Real>>& boxes,
+                     std::uint32_t max_leaf_size) {
+    const auto& nodes = tree.nodes();
+    const auto& order = tree.primitive_indices();
+    REQUIRE(order.size() == boxes.size());
+    std::vector<int> times_listed(boxes.size(), 0);
+    for (std::uint32_t p : order)
+        if (p < boxes.size()) ++times_listed[p];
+    CHECK(std::count(times_listed.begin(), times_listed.end(), 1) == std::ptrdiff_t(boxes.size()));
+    if (boxes.empty()) {
+        CHECK(nodes.empty());
+        CHECK(tree.depth() == 0);
+        return;
+    }
+    REQUIRE(!nodes.empty());
+    CHECK(nodes.size() <= 2 * boxes.size() - 1);
+
+    std::vector<int> slot_in_leaves(boxes.size(), 0), node_visits(nodes.size(), 0);
+    std::size_t child_outside = 0, primitive_outside = 0, oversized_leaves = 0, bad_index = 0;
+    int deepest = 0;
+    std::vector<std::pair<std::uint32_t, int>> stack{{0u, 1}};
+    while (!stack.empty()) {
+        const auto [index, depth] = stack.back();
+        stack.pop_back();
+        ++node_visits[index];
+        deepest = std::max(deepest, depth);
+        const prism::BvhNode<Real>& node = nodes[index];
+        if (node.is_leaf()) {
+            if (std::size_t(node.index) + node.count > boxes.size()) {
+                ++bad_index;
+                continue;
+            }
+            if (node.count > max_leaf_size) ++oversized_leaves;
+            for (std::uint32_t slot = node.index; slot < node.index + node.count; ++slot) {
+                ++slot_in_leaves[slot];
+                if (!contains(node.bounds, boxes[order[slot]])) ++primitive_outside;
+            }
+            continue;
+        }
+        if (node.index == 0 || std::size_t(node.index) + 1 >= nodes.size()) {
+            ++bad_index;
+            continue;
+        }
+        for (std::uint32_t child : {node.index, node.index + 1}) {
+            if (!contains(node.bounds, nodes[child].bounds)) ++child_outside;
+            stack.push_back({child, depth + 1});
+        }
+    }
+    CHECK(bad_index == 0);
+    CHECK(std::count(slot_in_leaves.begin(), slot_in_leaves.end(), 1) == std::ptrdiff_t(boxes.size()));
+    CHECK(std::count(node_visits.begin(), node_visits.end(), 1) == std::ptrdiff_t(nodes.size()));
+    CHECK(child_outside == 0);
+    CHECK(primitive_outside == 0);
+    CHECK(oversized_leaves == 0);
+    CHECK(deepest == tree.depth());
+    CHECK(tree.depth() < prism::BvhTree<Real>::max_depth);
+    prism::Aabb<Real> all;
+    for (const auto& box : boxes) all.extend(box);
+    CHECK(contains(tree.bounds(), all));
+}
+
+template <class Real>
+std::vector<prism::Aabb<Real>> triangle_boxes(const std::vector<glm::dvec3>& positions,
+                                              const std::vector<std::array<std::uint32_t, 3>>& triangles) {
+    std::vector<prism::Aabb<Real>> boxes(triangles.size());
+    for (std::size_t i = 0; i < triangles.size(); ++i)
+        for (std::uint32_t v : triangles[i]) boxes[i].extend(prism::Vec3<Real>(positions[v]));
+    return boxes;
+}
+
+// Rays from all around at the triangle's vertices, at points on its edges and inside it.
+template <class Real>
+std::vector<prism::Ray<Real>> rays_at_triangle(const std::array<glm::dvec3, 3>& triangle, std::size_t count,
+                                               std::mt19937& random) {
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    const auto directions = random_unit_vectors(random, count);
+    std::vector<prism::Ray<Real>> rays;
+    for (std::size_t i = 0; i < count; ++i) {
+        glm::dvec3 target = triangle[i % 3];
+        if (i % 4 == 1) target = glm::mix(triangle[i % 3], triangle[(i + 1) % 3], uniform(random));
+        if (i % 4 == 2) {
+            const double b1 = uniform(random), b2 = uniform(random) * (1 - b1);
+            target = (1 - b1 - b2) * triangle[0] + b1 * triangle[1] + b2 * triangle[2];
+        }
+        const glm::dvec3 origin = target - (0.5 + 3 * uniform(random)) * directions[i];
+        rays.push_back({prism::Vec3<Real>(origin), prism::Vec3<Real>(glm::normalize(target - origin)), Real(0),
+                        prism::infinity<Real>});
+    }
+    return rays;
+}
+
+}  // namespace
+
+TEST_CASE_TEMPLATE("BVH structure: a mesh, random boxes, one centroid, a geometric progression", Real, float, double) {
+    const std::uint32_t max_leaf_size = prism::BvhBuildOptions{}.max_leaf_size;
+    SUBCASE("perturbed icosphere, built in parallel") {
+        std::vector<glm::dvec3> positions;
+        std::vector<std::array<std::uint32_t, 3>> triangles;
+        perturbed_sphere(5, 11, positions, triangles);  // 20,480 triangles: above the parallel threshold
+        const auto boxes = triangle_boxes<Real>(positions, triangles);
+        const auto tree = prism::BvhTree<Real>::build(boxes);
+        check_structure(tree, boxes, max_leaf_size);
+        CHECK(tree.depth() > 10);  // a real hierarchy, not one leaf
+    }
+    SUBCASE("random boxes of every size") {
+        std::mt19937 random(5);
+        std::uniform_real_distribution<double> uniform(-100.0, 100.0), size(0.0, 10.0);
+        std::vector<prism::Aabb<Real>> boxes(3000);
+        for (auto& box : boxes) {
+            const prism::Vec3<Real> corner(Real(uniform(random)), Real(uniform(random)), Real(uniform(random)));
+            box.extend(corner);
+            box.extend(corner + prism::Vec3<Real>(Real(size(random)), Real(size(random)), Real(size(random))));
+        }
+        check_structure(prism::BvhTree<Real>::build(boxes), boxes, max_leaf_size);
+    }
+    SUBCASE("one centroid: copies of one box, and boxes nested around one centre") {
+        // SAH finds no plane between equal centroids; the build must still split by count.
+        std::vector<prism::Aabb<Real>> boxes(1000, prism::Aabb<Real>{prism::Vec3<Real>(-1), prism::Vec3<Real>(1)});
+        for (std::size_t i = 0; i < 500; ++i) {
+            const Real half = Real(0.01) * Real(i + 1);
+            boxes[2 * i] = {prism::Vec3<Real>(-half), prism::Vec3<Real>(half)};
+        }
+        const auto tree = prism::BvhTree<Real>::build(boxes);
+        check_structure(tree, boxes, max_leaf_size);
+        CHECK(tree.depth() <= 10);  // halving 1000 down to leaves of 8: about 8 levels
+    }
+    SUBCASE("a geometric progression of positions and sizes") {
+        // Each split peels off the few largest boxes, so the tree gets deep; the build must
+        // stop splitting before the traversal stack (64) overflows.
+        std::vector<prism::Aabb<Real>> boxes;
+        const int count = std::is_same_v<Real, float> ? 120 : 1000;
+        for (int i = 0; i < count; ++i) {
+            const Real x = std::ldexp(Real(1), -i);
+            boxes.push_back({prism::Vec3<Real>(x, 0, 0), prism::Vec3<Real>(x + x / 2, x / 2, x / 2)});
+        }
+        const auto tree = prism::BvhTree<Real>::build(boxes);
+        check_structure(tree, boxes, std::uint32_t(boxes.size()));  // the depth cap may leave big leaves
+        MESSAGE("geometric progression of " << count << " boxes: depth " << tree.depth());
+        // Traversal reaches every leaf, the deepest included: a ray down through each box.
+        std::size_t unreached = 0;
+        const auto& order = tree.primitive_indices();
+        for (int i = 0; i < count; ++i) {
+            const Real x = std::ldexp(Real(1), -i);
+            const prism::Ray<Real> ray{prism::Vec3<Real>(x + x / 4, x / 4, 1), prism::Vec3<Real>(0, 0, -1), Real(0),
+                                       prism::infinity<Real>};
+            const bool reached = tree.traverse_any(ray, prism::infinity<Real>, [&](std::uint32_t first, std::uint32_t n, Real&) {
+                return std::find(order.begin() + first, order.begin() + first + n, std::uint32_t(i)) != order.begin() + first + n;
+            });
+            unreached += reached ? 0 : 1;
+        }
+        CHECK(unreached == 0);
+    }
+}
+
+TEST_CASE_TEMPLATE("BVH on no primitives: an empty tree, an empty mesh, an empty scene", Real, float, double) {
+    const auto tree = prism::BvhTree<Real>::build({});
+    check_structure(tree, {}, 8);
+    CHECK(tree.bounds().is_empty());
+    const prism::Ray<Real> ray{prism::Vec3<Real>(0), prism::Vec3<Real>(0, 0, -1), Real(0), prism::infinity<Real>};
+    Real t_max = prism::infinity<Real>;
+    bool leaf_called = false;
+    tree.traverse_closest(ray, t_max, [&](std::uint32_t, std::uint32_t, Real&) { return leaf_called = true; });
+    CHECK_FALSE(leaf_called);
+    CHECK_FALSE(tree.traverse_any(ray, t_max, [&](std::uint32_t, std::uint32_t, Real&) { return true; }));
+
+    scene::Scene nothing;
+    scene::Scene empty_mesh;
+    empty_mesh.materials.push_back({});
+    empty_mesh.meshes.push_back({});
+    empty_mesh.mesh_instances.push_back({"moved", 0, 0, glm::translate(glm::dmat4(1.0), glm::dvec3(1, 2, 3))});
+    for (const scene::Scene* world : {&nothing, &empty_mesh}) {
+        const BvhGeometry<Real> bvh(*world);
+        const BruteGeometry<Real> brute(*world);
+        CHECK(bvh.triangle_count() == 0);
+        for (const prism::Vec3<Real> direction : {prism::Vec3<Real>(0, 0, -1), prism::Vec3<Real>(1, 2, 3)}) {
+            prism::Ray<Real> a{prism::Vec3<Real>(0), direction, Real(0), prism::infinity<Real>}, b = a;
+            prism::Hit<Real> hit;
+            CHECK_FALSE(bvh.intersect(a, hit));
+            CHECK_FALSE(brute.intersect(b, hit));
+            CHECK(a.t_max == prism::infinity<Real>);
+            CHECK_FALSE(bvh.occluded(a));
+            CHECK_FALSE(brute.occluded(b));
+        }
+    }
+}
+
+// A single triangle is a single leaf whose box is the triangle's own: rays at its vertices and
+// edges pass exactly through the box's corners and faces, where the slab test's rounding is
+// tightest. The BVH must hit whenever the watertight test alone hits, at the same t.
+TEST_CASE_TEMPLATE("BVH on one triangle: never culls a hit at a vertex or an edge", Real, float, double) {
+    std::mt19937 random(64);
+    std::uniform_real_distribution<double> uniform(-2.0, 2.0);
+    std::size_t rays_tested = 0, direct_hits = 0, lost = 0, wrong_t = 0, invented = 0;
+    for (int trial = 0; trial < 200; ++trial) {
+        std::array<glm::dvec3, 3> triangle;
+        for (auto& p : triangle) p = glm::dvec3(uniform(random), uniform(random), uniform(random));
+        if (trial % 4 == 0) triangle[1].z = triangle[2].z = triangle[0].z;  // flat box, as for floors
+        scene::Scene world;
+        world.materials.push_back({});
+        scene::Mesh mesh;
+        mesh.positions = {triangle[0], triangle[1], triangle[2]};
+        mesh.triangles = {{0, 1, 2}};
+        world.meshes.push_back(mesh);
+        const BvhGeometry<Real> bvh(world);
+        const prism::Vec3<Real> p0(triangle[0]), p1(triangle[1]), p2(triangle[2]);
+        for (const auto& ray : rays_at_triangle<Real>(triangle, 400, random)) {
+            ++rays_tested;
+            prism::TriangleHit<Real> direct;
+            const prism::Watertight::Prepared<Real> prepared(ray);
+            const bool expected = prism::Watertight::intersect(prepared, p0, p1, p2, ray.t_min, ray.t_max, direct);
+            prism::Ray<Real> traced = ray;
+            prism::Hit<Real> hit;
+            const bool found = bvh.intersect(traced, hit);
+            direct_hits += expected ? 1 : 0;
+            if (expected && !found) ++lost;
+            if (!expected && found) ++invented;
+            if (expected && found && hit.t != direct.t) ++wrong_t;
+        }
+    }
+    CHECK(direct_hits > rays_tested / 2);
+    CHECK(lost == 0);
+    CHECK(invented == 0);
+    CHECK(wrong_t == 0);
+}
+
+// The case the random test found on the course's tap mesh (hw3 tap_tap.ply, triangle 1202): the
+// ray passes exactly through the vertex at the box's (min x, max z) corner. The slab distances
+// are x: [1.1019235232159181, ...] and z: [..., 1.1019235232159179], one ulp apart, so a slab
+// test that does not widen each far distance culls the box, though the triangle is hit at
+// t = 1.1019235232159181.
+TEST_CASE("BvhTree<double>: the box of a triangle hit at its corner vertex is entered") {
+    using V = prism::Vec3<double>;
+    const V p0(-0.115581, -0.032274, 0.176249), p1(-0.131978, -0.044438, 0.176249), p2(-0.136777, -0.038591, 0.196117);
+    const prism::Ray<double> ray{V(-1.057053199581486, -0.30807918077148766, -0.34674881023758808),
+                                 V(0.83515432803875367, 0.2445616007769737, 0.49265289178441052), 0.0,
+                                 prism::infinity<double>};
+    prism::TriangleHit<double> direct;
+    REQUIRE(prism::Watertight::intersect(prism::Watertight::Prepared<double>(ray), p0, p1, p2, 0.0,
+                                         prism::infinity<double>, direct));
+    CHECK(direct.t == 1.1019235232159181);
+    prism::Aabb<double> box;
+    for (const V& p : {p0, p1, p2}) box.extend(p);
+    const auto tree = prism::BvhTree<double>::build(std::vector<prism::Aabb<double>>{box});
+    double t_max = prism::infinity<double>;
+    bool leaf_reached = false;
+    tree.traverse_closest(ray, t_max, [&](std::uint32_t, std::uint32_t, double&) { return leaf_reached = true; });
+    CHECK(leaf_reached);
+}
+
+TEST_CASE_TEMPLATE("BVH on many copies of one triangle: hits like brute force", Real, float, double) {
+    scene::Scene world;
+    world.materials.push_back({});
+    scene::Mesh mesh;
+    mesh.positions = {{-1, -1, -3}, {1, -1, -3}, {0, 1, -3}};
+    for (int i = 0; i < 1000; ++i) mesh.triangles.push_back({0, 1, 2});
+    world.meshes.push_back(mesh);
+    const BvhGeometry<Real> bvh(world);
+    const BruteGeometry<Real> brute(world);
+    REQUIRE(bvh.triangle_count() == 1000);
+    std::mt19937 random(3);
+    std::uniform_real_distribution<double> uniform(-1.5, 1.5);
+    std::size_t hits = 0, disagreements = 0;
+    for (int i = 0; i < 2000; ++i) {
+        const prism::Vec3<Real> target(Real(uniform(random)), Real(uniform(random)), Real(-3));
+        const prism::Vec3<Real> origin(Real(uniform(random)), Real(uniform(random)), Real(1));
+        prism::Ray<Real> a{origin, glm::normalize(target - origin), Real(0), prism::infinity<Real>}, b = a;
+        prism::Hit<Real> hit_a, hit_b;
+        const bool found_a = bvh.intersect(a, hit_a), found_b = brute.intersect(b, hit_b);
+        hits += found_b ? 1 : 0;
+        if (found_a != found_b || (found_a && hit_a.t != hit_b.t) || bvh.occluded(prism::Ray<Real>{origin, a.direction}) != found_b)
+            ++disagreements;
+    }
+    CHECK(hits > 300);
+    CHECK(hits < 2000);
+    CHECK(disagreements == 0);
+}
+
+// SceneGeometry's contract: closest hit in (t_min, t_max], any hit in (t_min, t_max), for every
+// kind of shape alike. A shadow ray towards a point on a surface (an area light's sample, say)
+// has t_max at that surface and must not be blocked by it.
+TEST_CASE_TEMPLATE("SceneGeometry: the hit interval is the same for triangles, spheres and planes", Real, float, double) {
+    // Along -z from the origin: a triangle at z = -2, a sphere with its near side at z = -2, a
+    // plane at z = -2; each alone in its scene, each hit at t = 2 exactly.
+    scene::Scene triangle_scene, sphere_scene, plane_scene;
+    for (scene::Scene* world : {&triangle_scene, &sphere_scene, &plane_scene}) world->materials.push_back({});
+    scene::Mesh mesh;
+    mesh.positions = {{-1, -1, -2}, {1, -1, -2}, {0, 1, -2}};
+    mesh.triangles = {{0, 1, 2}};
+    triangle_scene.meshes.push_back(mesh);
+    sphere_scene.spheres.push_back({"ball", 0, {0, 0, -3}, 1.0, glm::dmat4(1.0)});
+    plane_scene.planes.push_back({"wall", 0, {0, 0, -2}, {0, 0, 1}, glm::dmat4(1.0)});
+    const std::array<std::pair<std::string, const scene::Scene*>, 3> cases{
+        {{"triangle", &triangle_scene}, {"sphere", &sphere_scene}, {"plane", &plane_scene}}};
+    for (const auto& [shape, world] : cases) {
+        CAPTURE(shape);
+        const BvhGeometry<Real> geometry(*world);
+        const prism::Ray<Real> ray{prism::Vec3<Real>(0), prism::Vec3<Real>(0, 0, -1), Real(0), prism::infinity<Real>};
+        prism::Hit<Real> hit;
+        prism::Ray<Real> closed = ray;
+        closed.t_max = Real(2);
+        REQUIRE(geometry.intersect(closed, hit));
+        CHECK(hit.t == Real(2));
+        CHECK(closed.t_max == Real(2));
+        prism::Ray<Real> short_ray = ray;
+        short_ray.t_max = prism::next_down(Real(2));
+        CHECK_FALSE(geometry.intersect(short_ray, hit));
+        prism::Ray<Real> past = ray;
+        past.t_min = Real(2);
+        past.t_max = Real(2.5);
+        CHECK_FALSE(geometry.intersect(past, hit));
+
+        prism::Ray<Real> shadow = ray;
+        shadow.t_max = prism::next_up(Real(2));
+        CHECK(geometry.occluded(shadow));
+        shadow.t_max = Real(2);
+        CHECK_FALSE(geometry.occluded(shadow));  // open at t_max: fails for the triangle today
+    }
+}
+
+TEST_CASE_TEMPLATE("SceneGeometry: back-face culling skips surfaces facing away, only when asked", Real, float, double) {
+    scene::Scene world;
+    world.materials.push_back({});
+    scene::Mesh mesh;  // counter-clockwise seen from +z: faces +z
+    mesh.positions = {{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}};
+    mesh.triangles = {{0, 1, 2}};
+    world.meshes.push_back(mesh);
+    world.planes.push_back({"floor", 0, {0, 0, -5}, {0, 0, 1}, glm::dmat4(1.0)});
+    const BvhGeometry<Real> geometry(world);
+    const prism::Ray<Real> from_front{prism::Vec3<Real>(0, 0, 2), prism::Vec3<Real>(0, 0, -1)};
+    const prism::Ray<Real> from_behind{prism::Vec3<Real>(0, 0, -10), prism::Vec3<Real>(0, 0, 1)};
+    prism::Hit<Real> hit;
+    prism::Ray<Real> ray = from_front;
+    REQUIRE(geometry.template intersect<true>(ray, hit));
+    CHECK(hit.t == Real(2));
+    CHECK(hit.object == 0);
+    ray = from_behind;
+    CHECK_FALSE(geometry.template intersect<true>(ray, hit));  // both the plane and the triangle face away
+    ray = from_behind;
+    REQUIRE(geometry.template intersect<false>(ray, hit));
+    CHECK(hit.t == Real(5));
+    CHECK(hit.object == 1);  // planes are numbered after the instances
+    ray = from_behind;
+    ray.t_min = Real(6);
+    REQUIRE(geometry.template intersect<false>(ray, hit));
+    CHECK(hit.t == Real(10));
+    CHECK(hit.object == 0);
+}
