@@ -1,0 +1,689 @@
+// Intersection benchmarks (Google Benchmark). Every triangle intersector (NaiveEpsilon,
+// Watertight, DoubleRefine) in float and double traces the same ray batches (primary, shadow,
+// diffuse) over two workloads: the largest hw1 course scene and the tiny-triangle dragon
+// (dragon_lowres subdivided to 766,144 triangles, made in process with prism-stress's code);
+// Embree 3 traces them too when it is installed (PRISM_BENCH_WITH_EMBREE). Also: BVH build
+// times, and paired time ratios between variants that stand up to a shared, noisy machine.
+//
+// Every ray benchmark checks its answers: hit or miss (occluded or not, for shadow rays) per ray
+// against a double-precision Watertight reference computed once; robust variants that disagree
+// on more than `allowed_mismatch_fraction` of the rays stop with an error (tinybvh's lesson: a
+// benchmark that does not check its result measures nothing). Rays are traced one at a time on
+// one thread, so the ratios compare algorithms, not parallel scaling. After the run, a summary
+// prints this run's ratios, rays per second and answers. See bench/RESULTS.md.
+#include <prism/camera/pinhole_camera.hpp>
+#include <prism/geometry/double_refine.hpp>
+#include <prism/geometry/naive_epsilon.hpp>
+#include <prism/geometry/scene_geometry.hpp>
+#include <prism/geometry/subdivide.hpp>
+#include <prism/geometry/watertight.hpp>
+#include <prism/io/load.hpp>
+
+#include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
+
+#ifdef PRISM_BENCH_WITH_EMBREE
+#include <embree3/rtcore.h>
+#endif
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <numeric>
+#include <optional>
+#include <random>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <time.h>
+
+#ifndef PRISM_SHARED_DIR
+#define PRISM_SHARED_DIR "../shared"
+#endif
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace scene = prism::scene;
+using prism::Ray;
+using prism::Vec3;
+
+// ---------------------------------------------------------------------------------------------
+// Workloads and their ray batches
+
+constexpr std::size_t primary_ray_target = 1 << 17;  // camera rays per batch (about 131,000)
+
+// Far above the rounding of an origin to float (half an ulp of its largest coordinate) and of
+// the watertight test's own error in t, far below the triangles' size (the dragon's edges are
+// about 2e-3 of its coordinates): 256 float ulps of the hit point's largest coordinate.
+// Hit points near the origin use 1% of the scene's radius as their magnitude instead.
+double origin_offset(const glm::dvec3& point, double scene_radius) {
+    const double magnitude = std::max({std::abs(point.x), std::abs(point.y), std::abs(point.z), 1e-2 * scene_radius});
+    return 0x1p-16 * magnitude;
+}
+
+enum class BatchKind { primary, shadow, diffuse };
+constexpr std::array batch_kinds{BatchKind::primary, BatchKind::shadow, BatchKind::diffuse};
+
+const char* batch_name(BatchKind kind) {
+    switch (kind) {
+        case BatchKind::primary: return "primary";
+        case BatchKind::shadow: return "shadow";
+        case BatchKind::diffuse: return "diffuse";
+    }
+    return "?";
+}
+
+struct RayBatch {
+    bool any_hit = false;                 // shadow rays ask occluded(); the others the closest hit
+    std::vector<Ray<double>> rays;        // every value exactly representable in float...
+    std::vector<Ray<float>> rays_float;   // ...so these are the same rays
+    std::vector<std::uint8_t> reference;  // hit (occluded) per ray, by double-precision Watertight
+
+    template <class Real>
+    const std::vector<Ray<Real>>& rays_in() const {
+        if constexpr (std::is_same_v<Real, float>) return rays_float;
+        else return rays;
+    }
+};
+
+struct Workload {
+    std::string name;
+    std::string error;  // why the workload could not be made (course data missing); empty if made
+    scene::Scene scene; // meshes only (no spheres, planes or instances), one camera, one light
+    std::size_t triangle_count = 0;
+    std::array<RayBatch, 3> batches;
+};
+
+using ReferenceGeometry = prism::SceneGeometry<double, prism::Bvh<prism::Watertight>>;
+
+template <class Real, class Intersector>
+const prism::SceneGeometry<Real, prism::Bvh<Intersector>>& geometry_of(const Workload& workload) {
+    using Geometry = prism::SceneGeometry<Real, prism::Bvh<Intersector>>;
+    static std::map<const Workload*, std::unique_ptr<Geometry>> cache;
+    std::unique_ptr<Geometry>& slot = cache[&workload];
+    if (!slot) slot = std::make_unique<Geometry>(workload.scene);
+    return *slot;
+}
+
+Ray<double> representable_in_float(const Ray<double>& ray) {
+    return {Vec3<double>(Vec3<float>(ray.origin)), Vec3<double>(Vec3<float>(ray.direction)),
+            double(float(ray.t_min)), double(float(ray.t_max))};
+}
+
+Ray<float> to_float(const Ray<double>& ray) {
+    return {Vec3<float>(ray.origin), Vec3<float>(ray.direction), float(ray.t_min), float(ray.t_max)};
+}
+
+// An orthonormal basis around a unit normal (Duff et al., "Building an Orthonormal Basis,
+// Revisited", JCGT 2017).
+void basis(const glm::dvec3& n, glm::dvec3& tangent, glm::dvec3& bitangent) {
+    const double sign = std::copysign(1.0, n.z);
+    const double a = -1.0 / (sign + n.z);
+    const double b = n.x * n.y * a;
+    tangent = {1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x};
+    bitangent = {b, sign + n.y * n.y * a, -n.y};
+}
+
+// Camera rays through pixel centres at about primary_ray_target pixels; from each hit, a shadow
+// ray to the light (where the light is in front of the surface, as a renderer traces it) and a
+// cosine-distributed diffuse ray, both from the hit point offset along the normal facing the
+// camera. The reference answers come from double-precision Watertight on the same rays.
+void make_batches(Workload& workload) {
+    const scene::Camera& camera = workload.scene.cameras.at(0);
+    const glm::dvec3 light = workload.scene.point_lights.at(0).position;
+    const double scale = std::sqrt(double(primary_ray_target) / (double(camera.width) * camera.height));
+    const int width = std::max(1, int(std::lround(camera.width * scale)));
+    const int height = std::max(1, int(std::lround(camera.height * scale)));
+    const prism::PinholeCamera<double> pinhole(camera, width, height);
+
+    const ReferenceGeometry& reference = geometry_of<double, prism::Watertight>(workload);
+    const auto bounds = reference.bounds();
+    const double scene_radius = 0.5 * glm::length(bounds.max - bounds.min);
+
+    RayBatch& primary = workload.batches[0];
+    RayBatch& shadow = workload.batches[1];
+    RayBatch& diffuse = workload.batches[2];
+    shadow.any_hit = true;
+    std::mt19937_64 random(795);
+    const auto uniform = [&] { return double(random() >> 11) * 0x1p-53; };
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const Ray<double> ray = representable_in_float(pinhole.ray(x + 0.5, y + 0.5));
+            primary.rays.push_back(ray);
+            Ray<double> traced = ray;
+            prism::Hit<double> hit;
+            const bool found = reference.intersect(traced, hit);
+            primary.reference.push_back(found);
+            if (!found) continue;
+            const prism::SurfacePoint<double> point = reference.surface(traced, hit);
+            glm::dvec3 normal = point.geometric_normal;
+            if (glm::dot(normal, ray.direction) > 0) normal = -normal;
+            const glm::dvec3 origin = point.position + origin_offset(point.position, scene_radius) * normal;
+
+            const glm::dvec3 to_light = light - origin;
+            const double light_distance = glm::length(to_light);
+            if (glm::dot(to_light, normal) > 0)
+                shadow.rays.push_back(representable_in_float({origin, to_light / light_distance, 0.0, light_distance}));
+
+            glm::dvec3 tangent, bitangent;
+            basis(normal, tangent, bitangent);
+            const double u1 = uniform(), u2 = uniform();
+            const double radius = std::sqrt(u1), phi = 2.0 * prism::pi<double> * u2;
+            const glm::dvec3 direction = glm::normalize(radius * std::cos(phi) * tangent + radius * std::sin(phi) * bitangent +
+                                                        std::sqrt(std::max(0.0, 1.0 - u1)) * normal);
+            diffuse.rays.push_back(representable_in_float({origin, direction, 0.0, prism::infinity<double>}));
+        }
+    for (const Ray<double>& ray : shadow.rays) shadow.reference.push_back(reference.occluded(ray));
+    for (const Ray<double>& ray : diffuse.rays) {
+        Ray<double> traced = ray;
+        prism::Hit<double> hit;
+        diffuse.reference.push_back(reference.intersect(traced, hit));
+    }
+    for (RayBatch& batch : workload.batches)
+        for (const Ray<double>& ray : batch.rays) batch.rays_float.push_back(to_float(ray));
+}
+
+// The scene's meshes only, for a comparison with Embree on exactly the same triangles.
+scene::Scene meshes_only(scene::Scene scene) {
+    scene.spheres.clear();
+    scene.planes.clear();
+    scene.mesh_instances.clear();
+    return scene;
+}
+
+const fs::path course_scene_file =
+    fs::path(PRISM_SHARED_DIR) / "ceng795/hw1/2022F_Batucan2601/System_Files/inputs/akif_uslu/ton_Roosendaal_smooth.xml";
+const fs::path dragon_scene_file = fs::path(PRISM_SHARED_DIR) / "ceng795/hw1/2020_ozgurcanc/assets/scenes/dragon_lowres.xml";
+
+Workload make_workload(const std::string& name, const std::function<scene::Scene()>& load) {
+    Workload workload;
+    workload.name = name;
+    try {
+        const auto start = std::chrono::steady_clock::now();
+        workload.scene = load();
+        if (workload.scene.cameras.empty() || workload.scene.point_lights.empty())
+            throw std::runtime_error("the scene needs a camera and a point light");
+        for (const auto& mesh : workload.scene.meshes) workload.triangle_count += mesh.triangles.size();
+        make_batches(workload);
+        std::fprintf(stderr, "workload %s: %zu triangles, %zu primary, %zu shadow, %zu diffuse rays (made in %.1f s)\n",
+                     name.c_str(), workload.triangle_count, workload.batches[0].rays.size(),
+                     workload.batches[1].rays.size(), workload.batches[2].rays.size(),
+                     std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    } catch (const std::exception& error) {
+        workload.error = error.what();
+    }
+    return workload;
+}
+
+// The largest hw1 course scene: ton_Roosendaal_smooth, 78,620 triangles in three PLY meshes
+// (the largest hw1 PLY, mesh_2.ply, holds 62,160), with the course's camera and light.
+const Workload& course_workload() {
+    static const Workload workload =
+        make_workload("course", [] { return meshes_only(prism::io::load_scene(course_scene_file)); });
+    return workload;
+}
+
+// The tiny-triangle dragon: dragon_lowres's dragon subdivided three times (11,971 -> 766,144
+// triangles) at its original size, seen by the course file's camera, lit by its light.
+const Workload& dragon_workload() {
+    static const Workload workload = make_workload("dragon", [] {
+        scene::Scene scene = meshes_only(prism::io::load_scene(dragon_scene_file));
+        const auto largest = std::max_element(scene.meshes.begin(), scene.meshes.end(), [](const auto& a, const auto& b) {
+            return a.triangles.size() < b.triangles.size();
+        });
+        prism::IndexedMesh<double> dragon = prism::subdivide_midpoint(prism::world_space_mesh(*largest), 3);
+        scene::Mesh mesh = *largest;
+        mesh.transform = glm::dmat4(1.0);
+        mesh.positions = std::move(dragon.positions);
+        mesh.triangles = std::move(dragon.triangles);
+        mesh.normals.clear();
+        mesh.uvs.clear();
+        scene.meshes = {std::move(mesh)};
+        return scene;
+    });
+    return workload;
+}
+
+using WorkloadGetter = const Workload& (*)();
+constexpr std::array<std::pair<const char*, WorkloadGetter>, 2> workloads{
+    {{"course", &course_workload}, {"dragon", &dragon_workload}}};
+
+// ---------------------------------------------------------------------------------------------
+// The variants: each answers a whole batch (hit, or occluded for shadow rays, per ray), tracing
+// one ray at a time on the calling thread.
+
+using Answers = std::vector<std::uint8_t>;
+using TraceBatch = void (*)(const Workload&, const RayBatch&, Answers&);
+using BuildBenchmark = void (*)(benchmark::State&, const Workload&);
+
+template <class Real, class Intersector>
+void trace_prism(const Workload& workload, const RayBatch& batch, Answers& answers) {
+    const auto& geometry = geometry_of<Real, Intersector>(workload);
+    const std::vector<Ray<Real>>& rays = batch.rays_in<Real>();
+    if (batch.any_hit) {
+        for (std::size_t i = 0; i < rays.size(); ++i) answers[i] = geometry.occluded(rays[i]);
+    } else {
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            Ray<Real> ray = rays[i];
+            prism::Hit<Real> hit;
+            answers[i] = geometry.intersect(ray, hit);
+        }
+    }
+}
+
+template <class Real, class Intersector>
+void build_prism(benchmark::State& state, const Workload& workload) {
+    for (auto _ : state) {
+        const prism::SceneGeometry<Real, prism::Bvh<Intersector>> geometry(workload.scene);
+        benchmark::DoNotOptimize(geometry.bounds());
+    }
+}
+
+// Embree 3: the same triangles (rounded to float as prism's float variants round them), one
+// triangle geometry per mesh, default build quality; single rays (rtcIntersect1 / rtcOccluded1)
+// like prism's, with RTC_SCENE_FLAG_ROBUST off or on.
+#ifdef PRISM_BENCH_WITH_EMBREE
+
+RTCDevice embree_device() {
+    static RTCDevice device = [] {
+        // One thread, as prism's builds are timed (the ray queries never use more).
+        RTCDevice made = rtcNewDevice("threads=1");
+        if (made == nullptr) throw std::runtime_error("rtcNewDevice failed");
+        return made;
+    }();
+    return device;
+}
+
+RTCScene build_embree_scene(const scene::Scene& scene, bool robust) {
+    RTCDevice device = embree_device();
+    RTCScene embree_scene = rtcNewScene(device);
+    rtcSetSceneFlags(embree_scene, robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
+    for (const scene::Mesh& mesh : scene.meshes) {
+        RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+            geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.positions.size()));
+        for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+            const glm::vec3 p(glm::dvec3(mesh.transform * glm::dvec4(mesh.positions[v], 1.0)));
+            vertices[3 * v + 0] = p.x;
+            vertices[3 * v + 1] = p.y;
+            vertices[3 * v + 2] = p.z;
+        }
+        auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+            geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), mesh.triangles.size()));
+        for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+            for (int k = 0; k < 3; ++k) indices[3 * t + k] = mesh.triangles[t][k];
+        rtcCommitGeometry(geometry);
+        rtcAttachGeometry(embree_scene, geometry);
+        rtcReleaseGeometry(geometry);
+    }
+    rtcCommitScene(embree_scene);
+    return embree_scene;
+}
+
+RTCRay embree_ray(const Ray<float>& ray) {
+    RTCRay result;
+    result.org_x = ray.origin.x;
+    result.org_y = ray.origin.y;
+    result.org_z = ray.origin.z;
+    result.tnear = ray.t_min;
+    result.dir_x = ray.direction.x;
+    result.dir_y = ray.direction.y;
+    result.dir_z = ray.direction.z;
+    result.time = 0.0f;
+    result.tfar = ray.t_max;
+    result.mask = ~0u;
+    result.id = 0;
+    result.flags = 0;
+    return result;
+}
+
+template <bool Robust>
+void trace_embree(const Workload& workload, const RayBatch& batch, Answers& answers) {
+    static std::map<const Workload*, RTCScene> cache;
+    RTCScene& embree_scene = cache[&workload];
+    if (embree_scene == nullptr) embree_scene = build_embree_scene(workload.scene, Robust);
+    const std::vector<Ray<float>>& rays = batch.rays_float;
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    if (batch.any_hit) {
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            RTCRay ray = embree_ray(rays[i]);
+            rtcOccluded1(embree_scene, &context, &ray);
+            answers[i] = ray.tfar == -std::numeric_limits<float>::infinity();
+        }
+    } else {
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            RTCRayHit ray_hit;
+            ray_hit.ray = embree_ray(rays[i]);
+            ray_hit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            ray_hit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            rtcIntersect1(embree_scene, &context, &ray_hit);
+            answers[i] = ray_hit.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+        }
+    }
+}
+
+template <bool Robust>
+void build_embree(benchmark::State& state, const Workload& workload) {
+    for (auto _ : state) rtcReleaseScene(build_embree_scene(workload.scene, Robust));
+}
+
+#endif  // PRISM_BENCH_WITH_EMBREE
+
+struct Variant {
+    const char* name;
+    bool robust;           // must agree with the double reference, else the benchmark stops
+    TraceBatch trace;
+    BuildBenchmark build;  // nullptr: it builds what another variant builds (naive = watertight)
+};
+
+const std::vector<Variant>& variants() {
+    static const std::vector<Variant> list{
+        {"naive_float", false, &trace_prism<float, prism::NaiveEpsilon>, nullptr},
+        {"naive_double", false, &trace_prism<double, prism::NaiveEpsilon>, nullptr},
+        {"watertight_float", true, &trace_prism<float, prism::Watertight>, &build_prism<float, prism::Watertight>},
+        {"watertight_double", true, &trace_prism<double, prism::Watertight>, &build_prism<double, prism::Watertight>},
+        {"double_refine_float", true, &trace_prism<float, prism::DoubleRefine>,
+         &build_prism<float, prism::DoubleRefine>},
+#ifdef PRISM_BENCH_WITH_EMBREE
+        {"embree", false, &trace_embree<false>, &build_embree<false>},
+        {"embree_robust", false, &trace_embree<true>, &build_embree<true>},
+#endif
+    };
+    return list;
+}
+
+const Variant* find_variant(std::string_view name) {
+    for (const Variant& variant : variants())
+        if (name == variant.name) return &variant;
+    return nullptr;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Checking answers
+
+// A robust variant may disagree with the double reference only where the two precisions
+// round differently on a ray that grazes a silhouette edge, or passes within rounding of a
+// boundary edge of an open mesh (the dragon is open): a few rays per 100,000 at most (the
+// rays are the same float-representable rays for every variant, so the ray itself is never
+// the difference). 1e-4 of the batch (13 primary rays of 131,000) leaves room for that and
+// still catches a real leak, which loses whole edges' worth of rays: thousands here.
+constexpr double allowed_mismatch_fraction = 1e-4;
+
+struct Agreement {
+    std::size_t hits = 0, lost = 0, extra = 0;
+    std::size_t mismatches() const { return lost + extra; }
+};
+
+Agreement compare(const Answers& answers, const Answers& reference) {
+    Agreement agreement;
+    for (std::size_t i = 0; i < answers.size(); ++i) {
+        agreement.hits += answers[i];
+        if (answers[i] && !reference[i]) ++agreement.extra;
+        if (!answers[i] && reference[i]) ++agreement.lost;
+    }
+    return agreement;
+}
+
+// prism's watertight float answers, for Embree's ray-by-ray agreement with it.
+const Answers& watertight_float_answers(const Workload& workload, BatchKind kind) {
+    static std::map<std::pair<const Workload*, BatchKind>, Answers> cache;
+    const auto [found, added] = cache.try_emplace({&workload, kind});
+    if (added) {
+        const RayBatch& batch = workload.batches[std::size_t(kind)];
+        found->second.resize(batch.rays.size());
+        trace_prism<float, prism::Watertight>(workload, batch, found->second);
+    }
+    return found->second;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The benchmarks
+
+void trace_benchmark(benchmark::State& state, WorkloadGetter get, BatchKind kind, const Variant& variant) {
+    const Workload& workload = get();
+    if (!workload.error.empty()) return state.SkipWithError(workload.error.c_str());
+    const RayBatch& batch = workload.batches[std::size_t(kind)];
+    Answers answers(batch.rays.size());
+    variant.trace(workload, batch, answers);  // untimed: builds the structure, warms the caches
+    for (auto _ : state) {
+        variant.trace(workload, batch, answers);
+        benchmark::DoNotOptimize(answers.data());
+        benchmark::ClobberMemory();
+    }
+    const Agreement agreement = compare(answers, batch.reference);
+    const double rays = double(batch.rays.size());
+    state.counters["rays_per_second"] = benchmark::Counter(rays * double(state.iterations()), benchmark::Counter::kIsRate);
+    state.counters["rays"] = rays;
+    state.counters["hits"] = double(agreement.hits);
+    state.counters["mismatches"] = double(agreement.mismatches());
+    state.counters["lost"] = double(agreement.lost);
+    state.counters["extra"] = double(agreement.extra);
+    if (std::string_view(variant.name).starts_with("embree")) {
+        const Answers& prism_answers = watertight_float_answers(workload, kind);
+        std::size_t disagreements = 0;
+        for (std::size_t i = 0; i < answers.size(); ++i) disagreements += answers[i] != prism_answers[i];
+        state.counters["vs_watertight_float"] = double(disagreements);
+    }
+    if (variant.robust && double(agreement.mismatches()) > allowed_mismatch_fraction * rays) {
+        std::ostringstream message;
+        message << variant.name << " disagrees with the double-precision reference on " << agreement.mismatches()
+                << " of " << batch.rays.size() << " rays (" << agreement.lost << " lost, " << agreement.extra
+                << " extra; allowed: " << allowed_mismatch_fraction << " of the rays)";
+        state.SkipWithError(message.str().c_str());
+    }
+}
+
+// Builds run on one thread and are timed by the process's CPU time: the work of the build,
+// which the load of a shared machine does not inflate the way it inflates wall-clock time.
+void build_benchmark(benchmark::State& state, WorkloadGetter get, const Variant& variant) {
+    const Workload& workload = get();
+    if (!workload.error.empty()) return state.SkipWithError(workload.error.c_str());
+    const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+    variant.build(state, workload);
+    state.counters["triangles"] = double(workload.triangle_count);
+}
+
+// The ratios, measured in pairs: on a shared machine the load drifts between one benchmark
+// and the next, so separate benchmarks' medians compare different machines. Here every round
+// traces the batch once with each variant, in a new random order, timed by the thread's CPU
+// clock; a ratio is taken within each round and the median over rounds is reported, with
+// its quartiles to show the noise.
+constexpr int paired_rounds = 21;
+constexpr std::array<std::pair<const char*, const char*>, 5> ratio_pairs{{
+    {"watertight_float", "naive_float"},
+    {"double_refine_float", "watertight_float"},
+    {"watertight_double", "watertight_float"},
+    {"watertight_float", "embree"},
+    {"watertight_float", "embree_robust"},
+}};
+
+double thread_cpu_seconds() {
+    timespec now;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+    return double(now.tv_sec) + 1e-9 * double(now.tv_nsec);
+}
+
+void paired_ratio_benchmark(benchmark::State& state, WorkloadGetter get, BatchKind kind) {
+    const Workload& workload = get();
+    if (!workload.error.empty()) return state.SkipWithError(workload.error.c_str());
+    const RayBatch& batch = workload.batches[std::size_t(kind)];
+    const std::vector<Variant>& list = variants();
+    Answers answers(batch.rays.size());
+    for (const Variant& variant : list) variant.trace(workload, batch, answers);  // untimed: build and warm up
+    std::vector<std::vector<double>> seconds(list.size());
+    std::vector<std::size_t> order(list.size());
+    std::iota(order.begin(), order.end(), std::size_t(0));
+    std::mt19937 random(2025);
+    for (auto _ : state) {
+        for (int round = 0; round < paired_rounds; ++round) {
+            std::shuffle(order.begin(), order.end(), random);
+            for (const std::size_t v : order) {
+                const double start = thread_cpu_seconds();
+                list[v].trace(workload, batch, answers);
+                seconds[v].push_back(thread_cpu_seconds() - start);
+            }
+        }
+    }
+    for (const auto& [first, second] : ratio_pairs) {
+        const Variant *a = find_variant(first), *b = find_variant(second);
+        if (a == nullptr || b == nullptr) continue;
+        const std::vector<double>&seconds_a = seconds[std::size_t(a - list.data())],
+              &seconds_b = seconds[std::size_t(b - list.data())];
+        std::vector<double> ratios;
+        for (std::size_t round = 0; round < seconds_a.size(); ++round) ratios.push_back(seconds_a[round] / seconds_b[round]);
+        std::sort(ratios.begin(), ratios.end());
+        const std::string name = std::string(first) + "/" + second;
+        state.counters[name] = ratios[ratios.size() / 2];
+        state.counters[name + "_p25"] = ratios[ratios.size() / 4];
+        state.counters[name + "_p75"] = ratios[ratios.size() * 3 / 4];
+    }
+    state.counters["rays"] = double(batch.rays.size());
+}
+
+// ---------------------------------------------------------------------------------------------
+// The summary after the run: the paired ratios, each variant's rays per second (median over
+// repetitions) and answers, the build times.
+
+class SummaryReporter : public benchmark::ConsoleReporter {
+public:
+    void ReportRuns(const std::vector<Run>& runs) override {
+        for (const Run& run : runs) {
+            if (run.error_occurred) continue;
+            const bool median_aggregate = run.run_type == Run::RT_Aggregate && run.aggregate_name == "median";
+            if (run.run_type == Run::RT_Aggregate && !median_aggregate) continue;
+            Record& record = records_[run.run_name.function_name];
+            const double seconds = run.GetAdjustedCPUTime() / benchmark::GetTimeUnitMultiplier(run.time_unit);
+            const auto rate = run.counters.find("rays_per_second");
+            if (median_aggregate) {
+                record.median_seconds = seconds;
+                if (rate != run.counters.end()) record.median_rate = rate->second.value;
+            } else {
+                record.seconds.push_back(seconds);
+                if (rate != run.counters.end()) record.rates.push_back(rate->second.value);
+            }
+            for (const auto& [name, counter] : run.counters) record.counters[name] = counter.value;
+        }
+        ConsoleReporter::ReportRuns(runs);
+    }
+
+    void Finalize() override {
+        ConsoleReporter::Finalize();
+        std::ostream& out = GetOutputStream();
+        out << std::fixed;
+        out << "\nSummary of this run\n";
+        for (const auto& [workload, getter] : workloads) {
+            (void)getter;
+            for (BatchKind kind : batch_kinds) {
+                const std::string path = std::string(workload) + "/" + batch_name(kind);
+                out << path << ":\n";
+                if (const auto found = records_.find("ratios/" + path); found != records_.end()) {
+                    const auto& counters = found->second.counters;
+                    out << "  time ratios, paired (median of " << paired_rounds << " rounds [quartiles]):\n";
+                    for (const auto& [first, second] : ratio_pairs) {
+                        const std::string name = std::string(first) + "/" + second;
+                        if (!counters.count(name)) continue;
+                        out << "    " << std::left << std::setw(40) << (std::string(first) + " / " + second) << std::right
+                            << std::setprecision(3) << counters.at(name) << "  [" << counters.at(name + "_p25") << ", "
+                            << counters.at(name + "_p75") << "]\n";
+                    }
+                }
+                out << "  variant                  Mrays/s        hits  mismatches (lost, extra) of rays\n";
+                for (const Variant& variant : variants()) {
+                    const auto found = records_.find("rays/" + path + "/" + variant.name);
+                    if (found == records_.end()) continue;
+                    const Record& record = found->second;
+                    const auto counter = [&](const char* key) {
+                        const auto value = record.counters.find(key);
+                        return value == record.counters.end() ? std::string("-") : std::to_string(std::llround(value->second));
+                    };
+                    out << "    " << std::left << std::setw(20) << variant.name << std::right << std::setw(10)
+                        << std::setprecision(2) << record.rate().value_or(0) * 1e-6 << std::setw(12) << counter("hits")
+                        << std::setw(12) << counter("mismatches") << " (" << counter("lost") << ", " << counter("extra")
+                        << ") of " << counter("rays");
+                    if (record.counters.count("vs_watertight_float"))
+                        out << "; differs from watertight_float on " << counter("vs_watertight_float");
+                    out << "\n";
+                }
+            }
+        }
+        out << "build times (median CPU time, one thread):\n";
+        for (const auto& [name, record] : records_) {
+            if (!name.starts_with("build/")) continue;
+            out << "  " << std::left << std::setw(36) << name << std::right << std::setprecision(1)
+                << record.time().value_or(0) * 1e3 << " ms\n";
+        }
+    }
+
+private:
+    static std::optional<double> median(std::vector<double> values) {
+        if (values.empty()) return std::nullopt;
+        std::sort(values.begin(), values.end());
+        const std::size_t n = values.size();
+        return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+    }
+
+    struct Record {
+        std::vector<double> seconds, rates;  // per repetition
+        std::optional<double> median_seconds, median_rate;  // the median aggregate, if reported
+        std::map<std::string, double> counters;
+        std::optional<double> rate() const { return median_rate ? median_rate : median(rates); }
+        std::optional<double> time() const { return median_seconds ? median_seconds : median(seconds); }
+    };
+
+    std::map<std::string, Record> records_;
+};
+
+void register_benchmarks() {
+    for (const auto& [workload, getter] : workloads) {
+        for (BatchKind kind : batch_kinds) {
+            const std::string path = std::string(workload) + "/" + batch_name(kind);
+            for (const Variant& variant : variants())
+                benchmark::RegisterBenchmark(("rays/" + path + "/" + variant.name).c_str(),
+                                             [&variant, getter = getter, kind](benchmark::State& state) {
+                                                 trace_benchmark(state, getter, kind, variant);
+                                             })
+                    ->Unit(benchmark::kMillisecond);
+            benchmark::RegisterBenchmark(("ratios/" + path).c_str(),
+                                         [getter = getter, kind](benchmark::State& state) {
+                                             paired_ratio_benchmark(state, getter, kind);
+                                         })
+                ->Iterations(1)
+                ->Repetitions(1)
+                ->Unit(benchmark::kSecond);
+        }
+        for (const Variant& variant : variants()) {
+            if (variant.build == nullptr) continue;
+            benchmark::RegisterBenchmark(
+                (std::string("build/") + workload + "/" + variant.name).c_str(),
+                [&variant, getter = getter](benchmark::State& state) { build_benchmark(state, getter, variant); })
+                ->Unit(benchmark::kMillisecond)
+                ->MeasureProcessCPUTime();
+        }
+    }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    register_benchmarks();
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+    SummaryReporter reporter;
+    benchmark::RunSpecifiedBenchmarks(&reporter);
+    benchmark::Shutdown();
+    return 0;
+}
