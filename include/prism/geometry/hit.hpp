@@ -12,7 +12,9 @@ template <Scalar Real>
 struct Hit {
     Real t = infinity<Real>;
     std::uint32_t object = 0;     // index of the instance (or plane) hit
-    std::uint32_t primitive = 0;  // triangle within a mesh; 0 for spheres and planes
+    // A triangle's position in its mesh's index order (TriangleMesh reorders triangles for
+    // locality), not its position in scene::Mesh::triangles; 0 for spheres and planes.
+    std::uint32_t primitive = 0;
     Real b1 = 0, b2 = 0;          // barycentrics for triangles
 };
 

@@ -91,7 +91,11 @@ public:
             for (std::uint32_t slot = first; slot < first + count; ++slot) {
                 const auto& p = triangles_[slot];
                 TriangleHit<Real> triangle_hit;
-                if (Intersector::intersect(prepared, p[0], p[1], p[2], ray.t_min, t_limit, triangle_hit)) return true;
+                // Open at t_max, like spheres and planes: a shadow ray aimed at a point on a
+                // surface is not blocked by that surface.
+                if (Intersector::intersect(prepared, p[0], p[1], p[2], ray.t_min, t_limit, triangle_hit) &&
+                    triangle_hit.t < t_limit)
+                    return true;
             }
             return false;
         });

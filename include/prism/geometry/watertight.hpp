@@ -66,14 +66,13 @@ struct Watertight {
         const Real bz = ray.sz * b[ray.kz];
         const Real cz = ray.sz * c[ray.kz];
         const Real t_scaled = u * az + v * bz + w * cz;
-        // Compare t*det against the interval scaled by det, avoiding the division on misses.
-        if (det < 0) {
-            if (t_scaled >= t_min * det || t_scaled < t_max * det) return false;
-        } else {
-            if (t_scaled <= t_min * det || t_scaled > t_max * det) return false;
-        }
         const Real inverse_det = Real(1) / det;
-        hit.t = t_scaled * inverse_det;
+        // The interval is checked on the t that is reported: checking t_scaled against the
+        // det-scaled interval lets the two further roundings push t an ulp outside it, and
+        // then which of two triangles meeting at a vertex is closest depends on test order.
+        const Real t = t_scaled * inverse_det;
+        if (!(t > t_min && t <= t_max)) return false;
+        hit.t = t;
         hit.b1 = v * inverse_det;
         hit.b2 = w * inverse_det;
         return true;
