@@ -1,6 +1,7 @@
 // prism: renders every camera of a CENG795 scene file (XML or JSON) into its image file.
 // All cameras are rendered before any file is written, so a failure leaves no partial output.
 #include <prism/image/image_io.hpp>
+#include <prism/image/tonemap.hpp>
 #include <prism/io/load.hpp>
 #include <prism/render/progress.hpp>
 #include <prism/render/render_scene.hpp>
@@ -21,7 +22,9 @@ namespace {
 constexpr const char* usage = R"(usage: prism SCENE [options]
 
 Renders every camera of SCENE (a CENG795 .xml or .json scene file) and writes each camera's
-image under the name the scene gives it (.png: clamped to 0-255; .exr: linear radiance).
+image under the name the scene gives it (.png: clamped to 0-255; .exr: linear radiance). Each
+<Tonemap> of a camera adds an 8-bit image tone-mapped from the same render, named by the image
+name's stem and the Tonemap's <Extension>; a .png image name with Tonemaps is tone-mapped itself.
 
 options:
   --output-dir DIR     folder for the images (default: the current folder); created if missing
@@ -121,11 +124,16 @@ int main(int argc, char** argv) {
         progress.finish();
 
         for (const auto& rendered : images) {
-            const std::filesystem::path path = arguments.output_dir / rendered.image_name;
-            prism::write_image(path, rendered.image);
-            log << "camera " << scene.cameras[rendered.camera].id << ": " << path.string() << " ("
-                << rendered.image.width << "x" << rendered.image.height << ") rendered in " << rendered.seconds
-                << " s\n";
+            const prism::scene::Camera& camera = scene.cameras[rendered.camera];
+            log << "camera " << camera.id << ": " << rendered.image.width << "x" << rendered.image.height
+                << " rendered in " << rendered.seconds << " s\n";
+            // Every file of the camera comes from this one render: no tone mapping re-traces.
+            for (const prism::CameraOutput& output : prism::camera_outputs(camera)) {
+                const std::filesystem::path path = arguments.output_dir / output.name;
+                if (output.tonemap) prism::write_image(path, prism::tone_map(rendered.image, camera.tonemaps[*output.tonemap]));
+                else prism::write_image(path, rendered.image);
+                log << "  " << path.string() << '\n';
+            }
         }
     } catch (const std::exception& error) {
         std::cerr << "prism: " << error.what() << '\n';

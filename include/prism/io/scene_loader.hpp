@@ -7,9 +7,12 @@
 //     Position as a point, Gaze and Up as directions.
 //   - Mesh instances carry their whole transform (the instance's own, after the base mesh's unless
 //     resetTransform="true") and their material (their own, else the base's).
+//   - SpotLight angles are full apex angles in degrees; DirectionalLight's Direction is the way the
+//     light travels. A camera's Tonemaps must name distinct images.
 //   - Elements of later topics are skipped and named once each in Scene::unsupported.
 #pragma once
 
+#include <prism/image/tonemap.hpp>
 #include <prism/io/element.hpp>
 #include <prism/io/load_error.hpp>
 #include <prism/io/ply.hpp>
@@ -59,7 +62,16 @@ inline std::string_view trim(std::string_view text) {
     return text;
 }
 
-inline std::string in_quotes(std::string_view text) { return "\"" + std::string(text) + "\""; }
+// Appended piece by piece: `"\"" + std::string(text)` draws GCC 12's false -Wrestrict warning
+// (GCC bug 105651) wherever the optimiser inlines it.
+inline std::string in_quotes(std::string_view text) {
+    std::string quoted;
+    quoted.reserve(text.size() + 2);
+    quoted += '"';
+    quoted += text;
+    quoted += '"';
+    return quoted;
+}
 
 class Interpreter {
 public:
@@ -448,6 +460,10 @@ private:
             else if (hand != "right") fail(element, "handedness must be \"left\" or \"right\", not " + in_quotes(*handedness));
         }
 
+        for (const Element& child : element.children)
+            if (child.name == "Tonemap") camera.tonemaps.push_back(read_tonemap(child));
+        check_tonemap_names(element, camera);
+
         const glm::dmat4 transform = transformation_of(element);
         camera.position = transform_point(transform, camera.position);
         camera.gaze = transform_direction(transform, camera.gaze);
@@ -457,8 +473,59 @@ private:
 
         note_unsupported_children(element, {"Position", "Gaze", "GazePoint", "Up", "NearPlane", "NearDistance", "FovY",
                                             "ImageResolution", "ImageName", "NumSamples", "ApertureSize",
-                                            "FocusDistance", "Transformations"});
+                                            "FocusDistance", "Transformations", "Tonemap"});
         scene_.cameras.push_back(std::move(camera));
+    }
+
+    // <Tonemap><TMO>Photographic</TMO><TMOOptions>key burn%</TMOOptions><Saturation>
+    // <Gamma><Extension></Tonemap>; everything but TMO may be left out.
+    scene::Tonemap read_tonemap(const Element& element) {
+        scene::Tonemap tonemap;
+        const Element& tmo = required(element, "TMO");
+        const std::string name = text_of(tmo);
+        std::string lower = name;
+        std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+        if (lower == "photographic") tonemap.tone_operator = scene::TonemapOperator::photographic;
+        else if (lower == "aces") tonemap.tone_operator = scene::TonemapOperator::aces;
+        else if (lower == "filmic") tonemap.tone_operator = scene::TonemapOperator::filmic;
+        else fail(tmo, "unknown tone mapping operator " + in_quotes(name) + " (expected Photographic, ACES or Filmic)");
+        if (const Element* options = element.child("TMOOptions")) {
+            const std::vector<double> v = numbers(*options, 2);  // key, burn percentage
+            if (!(v[0] > 0.0)) fail(*options, "the key value must be positive");
+            if (v[1] < 0.0 || v[1] > 100.0) fail(*options, "the burn percentage must be between 0 and 100");
+            tonemap.key = v[0];
+            tonemap.burn_percent = v[1];
+        }
+        if (const Element* e = element.child("Saturation")) tonemap.saturation = non_negative(*e);
+        if (const Element* e = element.child("Gamma")) {
+            tonemap.gamma = number(*e);
+            if (!(tonemap.gamma > 0.0)) fail(*e, "the gamma must be positive");
+        }
+        if (const Element* e = element.child("Extension")) {
+            tonemap.extension = text_of(*e);
+            const std::filesystem::path suffix(tonemap.extension);
+            std::string type = suffix.extension().string();
+            std::transform(type.begin(), type.end(), type.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+            if (tonemap.extension.find('/') != std::string::npos || tonemap.extension.find('\\') != std::string::npos)
+                fail(*e, "the extension " + in_quotes(tonemap.extension) + " must not name a folder");
+            if (!type.empty() && type != ".png" && type != ".ppm")
+                fail(*e, "a tone-mapped image is 8-bit: the extension " + in_quotes(tonemap.extension) +
+                             " must end in .png or .ppm (or name no file type: .png is added)");
+        }
+        check_single(element, {"TMO", "TMOOptions", "Saturation", "Gamma", "Extension"});
+        note_unsupported_children(element, {"TMO", "TMOOptions", "Saturation", "Gamma", "Extension"});
+        return tonemap;
+    }
+
+    // Each Tonemap writes its own file (image/tonemap.hpp names them): two with the same name
+    // would silently overwrite one another.
+    void check_tonemap_names(const Element& camera_element, const scene::Camera& camera) const {
+        std::set<std::filesystem::path> names;
+        for (const scene::Tonemap& tonemap : camera.tonemaps)
+            if (!names.insert(tone_mapped_image_name(camera.image_name, tonemap)).second)
+                fail(camera_element, "two <Tonemap> elements write the same image " +
+                                         in_quotes(tone_mapped_image_name(camera.image_name, tonemap).string()) +
+                                         ": give them different <Extension>s");
     }
 
     void read_lights(const Element& section) {
@@ -472,10 +539,45 @@ private:
                 light.intensity = vector3(required(element, "Intensity"));
                 note_unsupported_children(element, {"Position", "Intensity", "Transformations"});
                 scene_.point_lights.push_back(std::move(light));
+            } else if (element.name == "DirectionalLight") {
+                scene::DirectionalLight light;
+                light.id = id_of(element);
+                const Element& direction = required(element, "Direction");
+                light.direction = transform_direction(transformation_of(element), vector3(direction));
+                if (glm::length(light.direction) == 0.0) fail(direction, "the direction is zero");
+                light.radiance = vector3(required(element, "Radiance"));
+                note_unsupported_children(element, {"Direction", "Radiance", "Transformations"});
+                scene_.directional_lights.push_back(std::move(light));
+            } else if (element.name == "SpotLight") {
+                scene_.spot_lights.push_back(read_spot_light(element));
             } else {
                 note_unsupported(element);
             }
         }
+    }
+
+    // Angles are the full apex angles of the cones, in degrees (light/spot_light.hpp).
+    scene::SpotLight read_spot_light(const Element& element) {
+        scene::SpotLight light;
+        light.id = id_of(element);
+        const glm::dmat4 transform = transformation_of(element);
+        light.position = transform_point(transform, vector3(required(element, "Position")));
+        const Element& direction = required(element, "Direction");
+        light.direction = transform_direction(transform, vector3(direction));
+        if (glm::length(light.direction) == 0.0) fail(direction, "the direction is zero");
+        light.intensity = vector3(required(element, "Intensity"));
+        const Element& coverage = required(element, "CoverageAngle");
+        light.coverage_angle = number(coverage);
+        if (!(light.coverage_angle > 0.0 && light.coverage_angle <= 360.0))
+            fail(coverage, "the coverage angle (the cone's full apex angle, in degrees) must be in (0, 360]");
+        const Element& falloff = required(element, "FalloffAngle");
+        light.falloff_angle = number(falloff);
+        if (!(light.falloff_angle >= 0.0 && light.falloff_angle <= light.coverage_angle))
+            fail(falloff, "the falloff angle must be between 0 and the coverage angle (" +
+                              std::to_string(light.coverage_angle) + " degrees)");
+        note_unsupported_children(element, {"Position", "Direction", "Intensity", "CoverageAngle", "FalloffAngle",
+                                            "Transformations"});
+        return light;
     }
 
     // ---- objects ----------------------------------------------------------------------------

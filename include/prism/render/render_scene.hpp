@@ -5,6 +5,9 @@
 
 #include <prism/geometry/double_refine.hpp>
 #include <prism/image/image.hpp>
+#include <prism/light/directional_light.hpp>
+#include <prism/light/point_light.hpp>
+#include <prism/light/spot_light.hpp>
 #include <prism/render/renderer.hpp>
 #include <prism/scene/features.hpp>
 #include <prism/scene/scene.hpp>
@@ -73,6 +76,23 @@ inline Choice choose_precision(const scene::Scene& scene, const RenderOptions& o
     return {Precision::double_all, measured + ", below 2^-16: double throughout"};
 }
 
+// The two light sets a scene can get: point lights alone (every hw1 and hw2 scene), or every
+// punctual light (point, directional, spot: glTF's word for lights that are a point or a
+// direction). Two, not one per combination, to keep the compiled renderers few.
+using PointLightSet = Lights<PointLight>;
+using PunctualLightSet = Lights<PointLight, DirectionalLight, SpotLight>;
+
+// Every light the scene describes, of any type. A light type added to scene::Scene must be
+// counted here, so that a renderer whose light set lacks it refuses the scene instead of
+// leaving the light out.
+inline std::size_t scene_light_count(const scene::Scene& scene) {
+    return scene.point_lights.size() + scene.directional_lights.size() + scene.spot_lights.size();
+}
+
+inline bool needs_punctual_lights(const scene::Scene& scene) {
+    return !scene.directional_lights.empty() || !scene.spot_lights.empty();
+}
+
 namespace detail {
 
 inline int scaled(int size, double scale) { return std::max(1, int(std::lround(size * scale))); }
@@ -80,6 +100,10 @@ inline int scaled(int size, double scale) { return std::max(1, int(std::lround(s
 template <class C>
 std::vector<CameraImage> render_with(const scene::Scene& scene, const RenderOptions& options, std::ostream& log,
                                      const std::function<void(std::size_t camera, int pixels)>& on_tile) {
+    if (C::LightTypes::count_in(scene) != scene_light_count(scene))
+        throw std::invalid_argument("the scene has " + std::to_string(scene_light_count(scene)) +
+                                    " lights, of which this renderer's light set can render only " +
+                                    std::to_string(C::LightTypes::count_in(scene)));
     using Clock = std::chrono::steady_clock;
     const auto build_start = Clock::now();
     const Renderer<C> renderer(scene, options.cull_backfaces);
@@ -97,6 +121,14 @@ std::vector<CameraImage> render_with(const scene::Scene& scene, const RenderOpti
         images.push_back({c, camera.image_name, std::move(image), seconds});
     }
     return images;
+}
+
+template <Scalar Real, class Acceleration>
+std::vector<CameraImage> render_with_lights(const scene::Scene& scene, const RenderOptions& options, std::ostream& log,
+                                            const std::function<void(std::size_t camera, int pixels)>& on_tile) {
+    if (needs_punctual_lights(scene))
+        return render_with<Config<Real, Acceleration, PunctualLightSet>>(scene, options, log, on_tile);
+    return render_with<Config<Real, Acceleration, PointLightSet>>(scene, options, log, on_tile);
 }
 
 }  // namespace detail
@@ -119,14 +151,16 @@ inline std::vector<CameraImage> render_scene(
     static constexpr const char* geometry_of[] = {"float BVH, watertight triangle tests",
                                                   "float BVH, double-precision watertight triangle tests",
                                                   "double BVH, watertight triangle tests"};
-    log << "configuration: " << geometry_of[int(choice.precision)] << ", point lights (" << choice.reason << ")\n";
+    log << "configuration: " << geometry_of[int(choice.precision)] << ", "
+        << (needs_punctual_lights(scene) ? "point, directional and spot lights" : "point lights") << " ("
+        << choice.reason << ")\n";
     switch (choice.precision) {
         case Precision::single:
-            return detail::render_with<Config<float, Bvh<Watertight>, Lights<PointLight>>>(scene, options, log, on_tile);
+            return detail::render_with_lights<float, Bvh<Watertight>>(scene, options, log, on_tile);
         case Precision::double_refine:
-            return detail::render_with<Config<float, Bvh<DoubleRefine>, Lights<PointLight>>>(scene, options, log, on_tile);
+            return detail::render_with_lights<float, Bvh<DoubleRefine>>(scene, options, log, on_tile);
         case Precision::double_all:
-            return detail::render_with<Config<double, Bvh<Watertight>, Lights<PointLight>>>(scene, options, log, on_tile);
+            return detail::render_with_lights<double, Bvh<Watertight>>(scene, options, log, on_tile);
     }
     throw std::logic_error("unknown precision");
 }

@@ -18,6 +18,21 @@ using Vec2 = glm::dvec2;
 using Vec3 = glm::dvec3;
 using Mat4 = glm::dmat4;  // column-major, as GLM; applied to column vectors (p' = M p)
 
+enum class TonemapOperator { photographic, aces, filmic };
+
+// A camera's <Tonemap>: which curve, and the parameters the course gives it. Key and burn are
+// <TMOOptions>; the burn (a percentage of pixels allowed to saturate) only shapes Photographic.
+struct Tonemap {
+    TonemapOperator tone_operator = TonemapOperator::photographic;
+    double key = 0.18;
+    double burn_percent = 0.0;
+    double saturation = 1.0;
+    double gamma = 2.2;
+    // Appended to the stem of the camera's ImageName to name this image ("_aces.png"); empty:
+    // the ImageName itself, or its stem + ".png" for an .exr ImageName.
+    std::string extension;
+};
+
 // A pinhole camera in the course's "Gaze + NearPlane" form. The loader turns `type="lookAt"`
 // cameras (GazePoint, FovY) and camera transformations into this form, so the renderer knows
 // a single camera model.
@@ -35,6 +50,9 @@ struct Camera {
     int num_samples = 1;
     double aperture_size = 0.0;
     double focus_distance = 0.0;
+    // One LDR image per entry, all from the one HDR render (image/tonemap.hpp); none: a .png
+    // is the course's clamp of radiance to 0..255.
+    std::vector<Tonemap> tonemaps;
 };
 
 struct PointLight {
@@ -43,7 +61,27 @@ struct PointLight {
     Vec3 intensity{0.0};
 };
 
-// Later topics' lights (area, directional, spot, environment) are added by their issues.
+// Parallel light from infinitely far away: Direction is the way the light travels, Radiance
+// arrives undiminished at every point it reaches.
+struct DirectionalLight {
+    std::string id;
+    Vec3 direction{0.0, -1.0, 0.0};
+    Vec3 radiance{0.0};
+};
+
+// A point light restricted to a cone around Direction. Both angles are FULL apex angles in
+// degrees, as the course writes them: full intensity within falloff_angle / 2 of the axis, a
+// smooth decline to zero at coverage_angle / 2 (light/spot_light.hpp).
+struct SpotLight {
+    std::string id;
+    Vec3 position{0.0};
+    Vec3 direction{0.0, -1.0, 0.0};
+    Vec3 intensity{0.0};
+    double coverage_angle = 0.0;
+    double falloff_angle = 0.0;
+};
+
+// Later topics' lights (area, environment) are added by their issues.
 
 enum class MaterialType { blinn_phong, mirror, conductor, dielectric };
 
@@ -120,6 +158,8 @@ struct Scene {
 
     std::vector<Camera> cameras;
     std::vector<PointLight> point_lights;
+    std::vector<DirectionalLight> directional_lights;
+    std::vector<SpotLight> spot_lights;
     std::vector<Material> materials;
     std::vector<Mesh> meshes;
     std::vector<Sphere> spheres;
