@@ -2,7 +2,8 @@
 // geometry/surface_error.hpp (triangle, sphere, transformed points, offset_ray_origin) checked
 // against higher-precision references, and pbrt-v4's Triangle.Reintersect protocol: random
 // triangles with coordinates log-uniform in 1e-8..1e8, rays spawned from their hits with the
-// error-bound offset never hit the same triangle again, while a fixed 1e-4 offset does.
+// error-bound offset never hit the same triangle again, while a fixed 1e-4 offset does; then the
+// same protocol for instanced triangles through SceneGeometry.
 #include <prism/accel/accelerator.hpp>
 #include <prism/geometry/double_refine.hpp>
 #include <prism/geometry/scene_geometry.hpp>
@@ -97,7 +98,8 @@ struct ReintersectCounts {
     int triangles = 0;            // triangles not degenerate after rounding to Real
     long incoming_hits = 0;       // rays aimed at a point of the triangle that found it
     long spawned = 0;             // rays leaving those hits (far side and near side)
-    long bound_rehits = 0;        // spawned from the error-bound offset, hitting the triangle again
+    long bound_rehits = 0;        // spawned from triangle_spawn_point's offset, hitting the triangle again
+    long hit_bound_rehits = 0;    // the same from pbrt's hit-point bound alone (triangle_hit_point)
     long origins_behind = 0;      // error-bound origins not strictly on their side of the exact plane
     long epsilon_rehits = 0;      // spawned from ray.at(t) + 1e-4 n, hitting the triangle again
     long epsilon_overshoots = 0;  // spawned with 1e-4 from a triangle narrower than 1e-4
@@ -148,6 +150,8 @@ ReintersectCounts reintersect(int triangle_count, int rays_per_triangle, std::ui
             ++counts.incoming_hits;
 
             const prism::PointWithError<Real> point =
+                prism::triangle_spawn_point(stored[0], stored[1], stored[2], hit.b1, hit.b2);
+            const prism::PointWithError<Real> hit_point =
                 prism::triangle_hit_point(stored[0], stored[1], stored[2], hit.b1, hit.b2);
             const Vec3 naive_point = incoming.at(hit.t);
             // The side the incoming ray came from: reflection leaves by it, transmission by the other.
@@ -160,6 +164,9 @@ ReintersectCounts reintersect(int triangle_count, int rays_per_triangle, std::ui
                 const prism::Ray<Real> bound_ray{prism::offset_ray_origin(point, normal, direction), direction,
                                                  Real(0), prism::infinity<Real>};
                 if (hit_triangle<I>(bound_ray, stored, again)) ++counts.bound_rehits;
+                const prism::Ray<Real> hit_bound_ray{prism::offset_ray_origin(hit_point, normal, direction),
+                                                     direction, Real(0), prism::infinity<Real>};
+                if (hit_triangle<I>(hit_bound_ray, stored, again)) ++counts.hit_bound_rehits;
                 const Wide chosen_side = glm::dot(direction, normal) < 0 ? Wide(-1) : Wide(1);
                 if (!(chosen_side * wide_dot(widen(bound_ray.origin) - widen(p[0]), exact_normal_wide) > 0))
                     ++counts.origins_behind;
@@ -313,6 +320,11 @@ TEST_CASE("double bounds are double-sized, float bounds float-sized") {
         const prism::Vec3<Real> p0(1, 0, 0), p1(0, 1, 0), p2(0, 0, 1);
         return prism::triangle_hit_point(p0, p1, p2, Real(1) / 3, Real(1) / 3);
     };
+    const auto spawn = [](auto one) {
+        using Real = decltype(one);
+        const prism::Vec3<Real> p0(1, 0, 0), p1(0, 1, 0), p2(0, 0, 1);
+        return prism::triangle_spawn_point(p0, p1, p2, Real(1) / 3, Real(1) / 3);
+    };
     const auto sphere = [](auto one) {
         using Real = decltype(one);
         return prism::sphere_hit_point(prism::Vec3<Real>(0), Real(1), prism::Vec3<Real>(Real(0.6), Real(0.8), 0));
@@ -330,11 +342,11 @@ TEST_CASE("double bounds are double-sized, float bounds float-sized") {
             prism::offset_ray_origin(point, prism::gamma<Real>(7) * point, normal, normal);
         return double(origin.z) - double(point.z);
     };
-    for (const auto& bound : {triangle(0.0).error, sphere(0.0).error, transformed(0.0).error}) {
+    for (const auto& bound : {triangle(0.0).error, spawn(0.0).error, sphere(0.0).error, transformed(0.0).error}) {
         CHECK(largest(bound) > 0);
         CHECK(largest(bound) < 1e-14);
     }
-    for (const auto& bound : {triangle(0.0f).error, sphere(0.0f).error, transformed(0.0f).error}) {
+    for (const auto& bound : {triangle(0.0f).error, spawn(0.0f).error, sphere(0.0f).error, transformed(0.0f).error}) {
         CHECK(largest(bound) > 1e-8f);
         CHECK(largest(bound) < 1e-5f);
     }
@@ -357,40 +369,27 @@ const ReintersectCounts& reintersect_counts() {
     return counts;
 }
 
-template <class V>
-void report_and_check_no_rehits() {
-    const ReintersectCounts& counts = reintersect_counts<V>();
-    MESSAGE(counts.triangles, " triangles, ", counts.incoming_hits, " hits, ", counts.spawned,
-            " spawned rays; re-hits: error-bound offset ", counts.bound_rehits, ", fixed 1e-4 offset ",
-            counts.epsilon_rehits);
-    // Most rays aimed at a point of a non-degenerate triangle find it; the rest graze it.
-    CHECK(counts.triangles > 800);
-    CHECK(counts.incoming_hits > 700000);
-    CHECK(counts.bound_rehits == 0);
-}
-
 }  // namespace
 
 // What the offset itself promises, whatever the intersector: the origin lies strictly on the
 // side it was pushed to, measured against the exact plane of the stored vertices.
-TEST_CASE_TEMPLATE("the error-bound origin lies strictly on its side of the exact plane", V, SpawnWatertightFloat,
+TEST_CASE_TEMPLATE("the spawn origin lies strictly on its side of the exact plane", V, SpawnWatertightFloat,
                    SpawnWatertightDouble, SpawnDoubleRefineFloat) {
     CHECK(reintersect_counts<V>().origins_behind == 0);
 }
 
-TEST_CASE_TEMPLATE("rays spawned with the error-bound offset never re-hit their triangle", V, SpawnDoubleRefineFloat) {
-    report_and_check_no_rehits<V>();
-}
-
-// Expected to fail until Watertight rejects hits with t below the bound on t's own error
-// (pbrt-v4 Triangle::Intersect, "Ensure that computed triangle t is conservatively greater than
-// zero"): the origin is measured to lie on the right side of the exact plane, yet the sheared
-// vertices' rounding gives the leaving ray a small positive t. With that test in Watertight this
-// case passes; then drop should_fail.
-TEST_CASE_TEMPLATE("rays spawned with the error-bound offset never re-hit their triangle: Watertight" *
-                       doctest::should_fail(),
-                   V, SpawnWatertightFloat, SpawnWatertightDouble) {
-    report_and_check_no_rehits<V>();
+// pbrt's hit-point bound alone is reported, not asserted: it leaves a few re-hits where a
+// triangle is large next to its distance from the origin (see triangle_spawn_point).
+TEST_CASE_TEMPLATE("rays spawned from triangle_spawn_point never re-hit their triangle", V, SpawnWatertightFloat,
+                   SpawnWatertightDouble, SpawnDoubleRefineFloat) {
+    const ReintersectCounts& counts = reintersect_counts<V>();
+    MESSAGE(counts.triangles, " triangles, ", counts.incoming_hits, " hits, ", counts.spawned,
+            " spawned rays; re-hits: triangle_spawn_point ", counts.bound_rehits, ", pbrt's hit-point bound alone ",
+            counts.hit_bound_rehits, ", fixed 1e-4 offset ", counts.epsilon_rehits);
+    // Most rays aimed at a point of a non-degenerate triangle find it; the rest graze it.
+    CHECK(counts.triangles > 800);
+    CHECK(counts.incoming_hits > 700000);
+    CHECK(counts.bound_rehits == 0);
 }
 
 // The hand-tuned epsilon fails both ways on the same data. In float it is below the error of
@@ -433,10 +432,23 @@ TEST_CASE_TEMPLATE("InstanceTransforms: the residual bounds |A M - I|", Real, fl
 
 namespace {
 
+// Rounds each coordinate to Real and back, so the double scene holds a mesh exact in Real. The
+// volatile is needed: GCC 12.2 at -O2 compiles out.x = double(float(in.x)); out.y = ...; into a
+// plain copy (an SLP vectorizer bug), and the mesh would silently stay unrounded.
+template <class Real>
+glm::dvec3 rounded_to(const glm::dvec3& p) {
+    glm::dvec3 result;
+    for (int axis = 0; axis < 3; ++axis) {
+        const volatile Real rounded = Real(p[axis]);
+        result[axis] = double(rounded);
+    }
+    return result;
+}
+
 struct InstancedCounts {
     long incoming_hits = 0, spawned = 0;
     long instance_rehits = 0;  // offset in object space with the round-trip bound
-    long world_rehits = 0;     // pbrt's way: world-space bound from transform_point, offset in world
+    long world_rehits = 0;     // pbrt's way: the spawn point through transform_point, offset in world
     long origins_behind = 0;   // object-space origins (as the traversal maps them) not on their side
 };
 
@@ -453,7 +465,7 @@ InstancedCounts reintersect_instanced(int triangle_count, int rays_per_triangle,
         prism::scene::Mesh mesh;
         for (int k = 0; k < 3; ++k)
             mesh.positions.push_back(
-                glm::dvec3(Vec3(offset + size * glm::dvec3(symmetric(rng), symmetric(rng), symmetric(rng)))));
+                rounded_to<Real>(offset + size * glm::dvec3(symmetric(rng), symmetric(rng), symmetric(rng))));
         mesh.triangles.push_back({0, 1, 2});
         mesh.transform =
             prism::translation(glm::dvec3(random_sign(rng) * log_uniform(rng, -3, 5), random_sign(rng) * log_uniform(rng, -3, 5),
@@ -486,7 +498,7 @@ InstancedCounts reintersect_instanced(int triangle_count, int rays_per_triangle,
             if (!geometry.intersect(incoming, hit)) continue;
             ++counts.incoming_hits;
             const prism::PointWithError<Real> object_point =
-                prism::triangle_hit_point(stored[0], stored[1], stored[2], hit.b1, hit.b2);
+                prism::triangle_spawn_point(stored[0], stored[1], stored[2], hit.b1, hit.b2);
             const prism::PointWithError<Real> world_point = prism::transform_point(instance.object_to_world, object_point);
             for (int k = 0; k < 2; ++k) {
                 const Vec3 direction(random_unit_vector(rng));
@@ -511,7 +523,8 @@ InstancedCounts reintersect_instanced(int triangle_count, int rays_per_triangle,
 
 }  // namespace
 
-// The round-trip bound is wider than the triangle's own: here Watertight needs no fix to pass.
+// The world-space count shows why InstanceTransforms exists: pbrt's transform_point bound, offset
+// in world space, misses the round trip back into object space.
 TEST_CASE_TEMPLATE("instanced triangles: rays spawned with the InstanceTransforms offset never re-hit", V,
                    SpawnWatertightFloat, SpawnWatertightDouble, SpawnDoubleRefineFloat) {
     const InstancedCounts counts = reintersect_instanced<typename V::Intersector, typename V::Real>(300, 1000, 31);

@@ -1,13 +1,16 @@
 // Leaving a surface without an epsilon: a hit point carried with a bound on its floating-point
 // error, and the ray origin pushed just past that bound along the normal (pbrt-v4, Pharr, Jakob
 // and Humphreys, "Physically Based Rendering" 4th ed., section 6.8: the triangle and sphere
-// bounds of 6.8.5, the transform bound of 6.8.6, OffsetRayOrigin of 6.8.6 "Robust spawned rays").
+// bounds of 6.8.5, the transform bound of 6.8.6, OffsetRayOrigin of 6.8.6 "Robust spawned rays"),
+// plus the margins pbrt handles elsewhere: the intersector's own error when a leaving ray meets
+// its triangle again, and the world/object round trip of instanced rays.
 // Every bound is a template on Real and uses gamma<Real>, so a double build gets double-sized
 // bounds (pbrt-v4's double build silently used float-sized ones).
 #pragma once
 
 #include <prism/math/floating_point.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 namespace prism {
@@ -47,6 +50,41 @@ PointWithError<Real> triangle_hit_point(const Vec3<double>& p0, const Vec3<doubl
     Vec3<Real> error = gamma<Real>(2) * glm::abs(point);
     for (int axis = 0; axis < 3; ++axis) error[axis] += next_up(Real(wide.error[axis]));
     return {point, error};
+}
+
+// The point a ray leaving a triangle starts from: triangle_hit_point, with the bound widened
+// along the normal by the margin the intersector itself needs. The new ray is tested against the
+// same triangle again, and the watertight test has errors of its own: it computes t det as
+// sum e_i z_i from edge functions e_i (2D cross products of sheared vertex coordinates that are
+// each a few u R off, R the distance from the hit point to the farthest vertex) and vertex depths
+// z_i <= R, so its error is some tens of u R^3, while its exact value for an origin at height h
+// above the plane is 2 A h (A the triangle's area). Past h ~ c u R (R^2 / 2A), the computed t
+// keeps the sign of the exact one and the triangle cannot be found again. This matters where a
+// triangle is large next to its distance from the origin (a ground quad around the origin, where
+// pbrt's sum |b_i p_i| is small next to R) and grows for slivers (R^2 / 2A large); elsewhere it is
+// far below the hit point's own error. pbrt-v4 instead rejects, in the intersector, every hit
+// with t below that error (Triangle::Intersect's deltaT); added to Watertight, that bound drops
+// valid hits: a 1e-7 triangle at distance 1 in float, a leak-test ray, 6% of the Reintersect
+// protocol's incoming rays. c = 16: in that protocol c = 4 already leaves no re-hit over 9
+// seeds; the estimate above gives ~18. The margin is taken in the precision the triangle is
+// tested in (Vertex: double for DoubleRefine).
+template <Scalar Real, Scalar Vertex>
+PointWithError<Real> triangle_spawn_point(const Vec3<Vertex>& p0, const Vec3<Vertex>& p1, const Vec3<Vertex>& p2,
+                                          Real b1, Real b2) {
+    PointWithError<Real> result = triangle_hit_point(p0, p1, p2, b1, b2);
+    // In double for both precisions: R^3 overflows float for coordinates past ~1e12.
+    const glm::dvec3 q0(p0), q1(p1), q2(p2), hit(result.point);
+    const double reach_squared = std::max({glm::dot(q0 - hit, q0 - hit), glm::dot(q1 - hit, q1 - hit),
+                                           glm::dot(q2 - hit, q2 - hit)});
+    const glm::dvec3 cross = glm::cross(q1 - q0, q2 - q0);
+    const double twice_area = glm::length(cross);
+    // A triangle of no area has no plane to leave, and the watertight test never hits it.
+    if (!(twice_area > 0)) return result;
+    const double margin = double(gamma<Vertex>(16)) * std::sqrt(reach_squared) * (reach_squared / twice_area);
+    // Adding margin |n| to the box adds exactly margin to offset_ray_origin's |n| . error.
+    const glm::dvec3 normal = glm::abs(cross / twice_area);
+    for (int axis = 0; axis < 3; ++axis) result.error[axis] += next_up(Real(margin * normal[axis]));
+    return result;
 }
 
 // A sphere's hit point reprojected onto the sphere: q = p - center scaled by radius / |q|
@@ -131,25 +169,29 @@ struct InstanceTransforms {
     // Rounds the matrices exactly as SceneGeometry does, so A is the traversal's own matrix.
     explicit InstanceTransforms(const glm::dmat4& transform)
         : object_to_world(transform), world_to_object(glm::inverse(transform)) {
-        // A M - I in double, plus the rounding of that double sum (gamma(5): one product and
-        // four sums of |A||M| terms), rounded up to Real.
-        const glm::dmat4 a(world_to_object), m(object_to_world);
+        // The bound is derived from the double matrices, never by widening the rounded ones back
+        // to double (GCC 12.2's SLP vectorizer can fold such a double->Real->double round trip
+        // into a copy). Each stored entry is its double value times (1 + d), |d| <= u, so
+        // |A M - A_d M_d| <= (2u + u^2) |A_d| |M_d| <= gamma(2) |A_d| |M_d|; A_d M_d - I itself is
+        // summed in double, off by at most gamma<double>(5) (|A_d| |M_d| + 1).
+        const glm::dmat4 inverse = glm::inverse(transform);
+        const double stored_rounding = double(gamma<Real>(2));
         for (int column = 0; column < 4; ++column)
             for (int row = 0; row < 3; ++row) {
                 double product = 0, magnitude = 0;
                 for (int k = 0; k < 4; ++k) {
-                    product += a[k][row] * m[column][k];
-                    magnitude += std::abs(a[k][row] * m[column][k]);
+                    product += inverse[k][row] * transform[column][k];
+                    magnitude += std::abs(inverse[k][row] * transform[column][k]);
                 }
-                const double bound =
-                    std::abs(product - (column == row ? 1.0 : 0.0)) + gamma<double>(5) * (magnitude + 1.0);
+                const double bound = std::abs(product - (column == row ? 1.0 : 0.0)) +
+                                     gamma<double>(5) * (magnitude + 1.0) + stored_rounding * magnitude;
                 residual[column][row] = next_up(Real(bound));
             }
     }
 };
 
 // The world-space origin of a ray leaving an instanced surface toward `world_direction`, given
-// the hit point in object space with its error (triangle_hit_point or sphere_hit_point on the
+// the hit point in object space with its error (triangle_spawn_point or sphere_hit_point on the
 // object-space shape) and the unit object-space geometric normal.
 template <Scalar Real>
 Vec3<Real> offset_ray_origin(const InstanceTransforms<Real>& instance, const PointWithError<Real>& object_point,
