@@ -648,6 +648,48 @@ TEST_CASE("numbers in any course spelling parse; TexCoordData and vertexOffset r
 
 // ---- broken input: each names the file and the element --------------------------------------
 
+namespace {
+
+// A binary data file as the course writes it: an int32 record count, then the values.
+template <class Value>
+std::string binary_records(std::int32_t count, const std::vector<Value>& values) {
+    std::string bytes(sizeof count + values.size() * sizeof(Value), '\0');
+    std::memcpy(bytes.data(), &count, sizeof count);
+    if (!values.empty()) std::memcpy(bytes.data() + sizeof count, values.data(), values.size() * sizeof(Value));
+    return bytes;
+}
+
+}  // namespace
+
+TEST_CASE("binaryFile vertex data, texture coordinates and faces read like their text forms") {
+    TemporaryFolder folder;
+    folder.write("vertices.bin", binary_records<float>(4, {0, 0, -2, 1, 0, -2, 1, 1, -2, 0, 1, -2}));
+    folder.write("uv.bin", binary_records<float>(4, {0, 0, 1, 0, 1, 1, 0, 1}));
+    folder.write("faces.bin", binary_records<std::int32_t>(2, {1, 2, 3, 1, 3, 4}));
+    SceneParts parts;
+    parts.vertices = "";
+    parts.objects = R"(<Mesh id="1"><Material>1</Material><Faces binaryFile="faces.bin"/></Mesh>)";
+    std::string xml = scene_xml(parts);
+    xml.replace(xml.find("<VertexData>"), std::string("<VertexData>").size(), R"(<VertexData binaryFile="vertices.bin">)");
+    xml.replace(xml.find("</Scene>"), 0, R"(<TexCoordData binaryFile="uv.bin"/>)" "\n");
+    const fs::path scene_file = folder.write("binary.xml", xml);
+    const Scene scene = load_scene(scene_file);
+    REQUIRE(scene.meshes.size() == 1);
+    const auto& mesh = scene.meshes[0];
+    REQUIRE(mesh.triangles.size() == 2);
+    REQUIRE(mesh.positions.size() == 4);
+    CHECK(near(mesh.positions[mesh.triangles[1][2]], Vec3(0, 1, -2)));
+    REQUIRE(mesh.uvs.size() == 4);
+    CHECK(mesh.uvs[mesh.triangles[0][1]] == glm::dvec2(1, 0));
+
+    // A count the file cannot hold is one clear error naming the file and the element.
+    folder.write("faces.bin", binary_records<std::int32_t>(1000000, {1, 2, 3}));
+    const std::string message = load_error_of([&] { load_scene(scene_file); });
+    CHECK(contains(message, "faces.bin"));
+    CHECK(contains(message, "Faces"));
+    CHECK(contains(message, "declares 1000000 records"));
+}
+
 TEST_CASE("malformed XML: an unclosed tag") {
     TemporaryFolder folder;
     SceneParts parts;

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <prism/image/tonemap.hpp>
+#include <prism/io/binary_data.hpp>
 #include <prism/io/element.hpp>
 #include <prism/io/load_error.hpp>
 #include <prism/io/ply.hpp>
@@ -236,10 +237,25 @@ private:
 
     // ---- definitions ------------------------------------------------------------------------
 
+    // Reads the element's binaryFile (resolved against the scene's folder) with one of the
+    // read_binary_* readers; their errors name the binary file, this adds the element.
+    template <class Read>
+    auto read_binary_file(const Element& element, Read&& read) const {
+        const std::filesystem::path path = folder_ / std::string(trim(*element.attribute("binaryFile")));
+        try {
+            return read(path);
+        } catch (const LoadError& error) {
+            throw LoadError(file_, element.where(), error.what());
+        }
+    }
+
     void read_vertex_data(const Element& element) {
         if (const std::string* type = element.attribute("type"); type != nullptr && trim(*type) != "xyz")
             fail(element, "unsupported vertex data type " + in_quotes(*type) + " (expected \"xyz\")");
-        const std::vector<double> v = numbers(element);
+        const std::vector<double> v =
+            element.attribute("binaryFile") != nullptr
+                ? read_binary_file(element, [](const auto& path) { return read_binary_floats(path, 3, "vertex data"); })
+                : numbers(element);
         if (v.size() % 3 != 0)
             fail(element, std::to_string(v.size()) + " numbers do not make x y z triples");
         vertices_.reserve(v.size() / 3);
@@ -247,7 +263,11 @@ private:
     }
 
     void read_texture_coordinates(const Element& element) {
-        const std::vector<double> v = numbers(element);
+        const std::vector<double> v =
+            element.attribute("binaryFile") != nullptr
+                ? read_binary_file(element,
+                                    [](const auto& path) { return read_binary_floats(path, 2, "texture coordinates"); })
+                : numbers(element);
         if (v.size() % 2 != 0) fail(element, std::to_string(v.size()) + " numbers do not make u v pairs");
         texture_coordinates_.reserve(v.size() / 2);
         for (std::size_t i = 0; i < v.size(); i += 2) texture_coordinates_.push_back({v[i], v[i + 1]});
@@ -686,7 +706,13 @@ private:
             if (const std::string* ply = faces.attribute("plyFile")) {
                 add_ply_faces(mesh, faces, std::string(trim(*ply)));
             } else {
-                add_indexed_faces(builder, faces, integers(faces), integer_attribute(faces, "vertexOffset", 0),
+                // Binary face indices mean what inline ones do: 1-based, shifted by vertexOffset.
+                const std::vector<long long> indices =
+                    faces.attribute("binaryFile") != nullptr
+                        ? read_binary_file(faces,
+                                            [](const auto& path) { return read_binary_integers(path, 3, "faces"); })
+                        : integers(faces);
+                add_indexed_faces(builder, faces, indices, integer_attribute(faces, "vertexOffset", 0),
                                   integer_attribute(faces, "textureOffset", 0));
             }
         }
