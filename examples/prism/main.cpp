@@ -114,10 +114,7 @@ int main(int argc, char** argv) {
         const prism::scene::Scene scene = prism::io::load_scene(arguments.scene);
         if (scene.cameras.empty()) throw prism::io::LoadError(arguments.scene, "<Cameras>", "the scene has no camera");
 
-        std::size_t total_pixels = 0;
-        for (const auto& camera : scene.cameras)
-            total_pixels += std::size_t(std::max(1L, std::lround(camera.width * arguments.options.resolution_scale))) *
-                            std::size_t(std::max(1L, std::lround(camera.height * arguments.options.resolution_scale)));
+        const std::size_t total_pixels = prism::total_pixels(scene, arguments.options);
         prism::ProgressBar progress(total_pixels, !arguments.quiet);
         const auto images = prism::render_scene(scene, arguments.options, log,
                                                 [&](std::size_t, int pixels) { progress.advance(std::size_t(pixels)); });

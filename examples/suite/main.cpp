@@ -428,10 +428,7 @@ void run_job(const Arguments& arguments, const Job& job, std::size_t index, std:
         if (scene.cameras.empty())
             throw prism::io::LoadError(job.scene_file, "<Cameras>", "the scene has no camera");
 
-        std::size_t total_pixels = 0;
-        for (const auto& camera : scene.cameras)
-            total_pixels += std::size_t(prism::detail::scaled(camera.width, arguments.options.resolution_scale)) *
-                            std::size_t(prism::detail::scaled(camera.height, arguments.options.resolution_scale));
+        const std::size_t total_pixels = prism::total_pixels(scene, arguments.options);
         std::vector<prism::CameraImage> images;
         {
             prism::ProgressBar progress(total_pixels, true,

@@ -43,7 +43,6 @@ struct RenderOptions {
     int threads = 0;                      // 0: all hardware threads
     std::optional<Precision> precision;   // empty: chosen from the scene
     double resolution_scale = 1.0;        // < 1 renders a reduced image (suite, quick checks)
-    bool progress = false;                // progress bar on stderr
     bool cull_backfaces = false;          // primary rays skip triangles facing away
 };
 
@@ -93,9 +92,19 @@ inline bool needs_punctual_lights(const scene::Scene& scene) {
     return !scene.directional_lights.empty() || !scene.spot_lights.empty();
 }
 
-namespace detail {
+// The image size a camera renders at under RenderOptions::resolution_scale (at least 1 pixel).
+inline int scaled_size(int size, double scale) { return std::max(1, int(std::lround(size * scale))); }
 
-inline int scaled(int size, double scale) { return std::max(1, int(std::lround(size * scale))); }
+// Pixels render_scene will report through on_tile, for sizing a progress bar.
+inline std::size_t total_pixels(const scene::Scene& scene, const RenderOptions& options) {
+    std::size_t total = 0;
+    for (const auto& camera : scene.cameras)
+        total += std::size_t(scaled_size(camera.width, options.resolution_scale)) *
+                 std::size_t(scaled_size(camera.height, options.resolution_scale));
+    return total;
+}
+
+namespace detail {
 
 template <class C>
 std::vector<CameraImage> render_with(const scene::Scene& scene, const RenderOptions& options, std::ostream& log,
@@ -113,8 +122,8 @@ std::vector<CameraImage> render_with(const scene::Scene& scene, const RenderOpti
     std::vector<CameraImage> images;
     for (std::size_t c = 0; c < scene.cameras.size(); ++c) {
         const scene::Camera& camera = scene.cameras[c];
-        const int width = scaled(camera.width, options.resolution_scale);
-        const int height = scaled(camera.height, options.resolution_scale);
+        const int width = scaled_size(camera.width, options.resolution_scale);
+        const int height = scaled_size(camera.height, options.resolution_scale);
         const auto start = Clock::now();
         Image image = renderer.render(camera, width, height, [&](int pixels) { on_tile(c, pixels); });
         const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
