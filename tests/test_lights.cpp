@@ -2,6 +2,8 @@
 // across and outside with no ring at its edges, shadow rays to infinity through the renderer,
 // the dispatcher's refusal to drop a light, and the loader reading the new elements (lights and
 // Tonemap) from XML and JSON.
+#include "temporary_folder.hpp"
+
 #include <prism/io/load.hpp>
 #include <prism/light/directional_light.hpp>
 #include <prism/light/spot_light.hpp>
@@ -51,28 +53,7 @@ double course_spot_factor(double alpha_degrees, double coverage, double falloff)
     return std::pow((cos_alpha - cos_coverage) / (cos_falloff - cos_coverage), 4);
 }
 
-class TemporaryFolder {
-public:
-    TemporaryFolder() {
-        std::random_device random;
-        path_ = fs::temp_directory_path() / ("prism_lights_" + std::to_string(random()) + std::to_string(random()));
-        fs::create_directories(path_);
-    }
-    ~TemporaryFolder() {
-        std::error_code ignored;
-        fs::remove_all(path_, ignored);
-    }
-    TemporaryFolder(const TemporaryFolder&) = delete;
-    TemporaryFolder& operator=(const TemporaryFolder&) = delete;
-
-    fs::path write(const std::string& name, const std::string& contents) const {
-        std::ofstream(path_ / name, std::ios::binary) << contents;
-        return path_ / name;
-    }
-
-private:
-    fs::path path_;
-};
+using prism_test::TemporaryFolder;
 
 std::string load_error_of(const fs::path& file) {
     try {

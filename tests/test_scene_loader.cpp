@@ -1,6 +1,8 @@
 // Scene loading: every course scene of the manifest, each XML scene against its JSON twin,
 // hand-checked scenes (camera, lookAt near plane, transformations, instances), and one test per
 // kind of broken input, each of which must name the file and the element at fault.
+#include "temporary_folder.hpp"
+
 #include <prism/io/load.hpp>
 #include <prism/math/transform.hpp>
 
@@ -229,28 +231,7 @@ std::vector<std::string> compare_scenes(const Scene& a, const Scene& b) {
 
 // ---- scenes written by the tests ------------------------------------------------------------
 
-class TemporaryFolder {
-public:
-    TemporaryFolder() {
-        std::random_device random;
-        path_ = fs::temp_directory_path() / ("prism_scene_loader_" + std::to_string(random()) + std::to_string(random()));
-        fs::create_directories(path_);
-    }
-    ~TemporaryFolder() {
-        std::error_code ignored;
-        fs::remove_all(path_, ignored);
-    }
-    TemporaryFolder(const TemporaryFolder&) = delete;
-    TemporaryFolder& operator=(const TemporaryFolder&) = delete;
-
-    fs::path write(const std::string& name, const std::string& contents) const {
-        std::ofstream(path_ / name, std::ios::binary) << contents;
-        return path_ / name;
-    }
-
-private:
-    fs::path path_;
-};
+using prism_test::TemporaryFolder;
 
 struct SceneParts {
     std::string camera = R"(<Camera id="1">
