@@ -1,5 +1,7 @@
 // prism: renders every camera of a CENG795 scene file (XML or JSON) into its image file.
 // All cameras are rendered before any file is written, so a failure leaves no partial output.
+#include "../common/command_line.hpp"
+
 #include <prism/image/image_io.hpp>
 #include <prism/image/tonemap.hpp>
 #include <prism/io/load.hpp>
@@ -18,6 +20,8 @@
 #include <vector>
 
 namespace {
+
+const prism::CommandLine command_line("prism");
 
 constexpr const char* usage = R"(usage: prism SCENE [options]
 
@@ -47,60 +51,35 @@ struct Arguments {
     bool quiet = false;
 };
 
-[[noreturn]] void usage_error(const std::string& message) {
-    std::cerr << "prism: " << message << "\n(see prism --help)\n";
-    std::exit(2);
-}
-
-template <class Number>
-Number parse_number(std::string_view option, std::string_view text) {
-    Number value{};
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (error != std::errc() || end != text.data() + text.size())
-        usage_error(std::string(option) + ": not a number: '" + std::string(text) + "'");
-    return value;
-}
-
 Arguments parse_arguments(int argc, char** argv) {
     Arguments arguments;
     std::vector<std::string_view> args(argv + 1, argv + argc);
     for (std::size_t i = 0; i < args.size(); ++i) {
         const std::string_view arg = args[i];
         const auto value = [&]() -> std::string_view {
-            if (i + 1 >= args.size()) usage_error(std::string(arg) + " needs a value");
+            if (i + 1 >= args.size()) command_line.usage_error(std::string(arg) + " needs a value");
             return args[++i];
         };
         if (arg == "--help" || arg == "-h") {
             std::cout << usage;
             std::exit(0);
+        } else if (command_line.render_option(arg, value, arguments.options)) {
+            continue;
         } else if (arg == "--output-dir") {
             arguments.output_dir = std::filesystem::path(value());
-        } else if (arg == "--threads") {
-            arguments.options.threads = parse_number<int>(arg, value());
-            if (arguments.options.threads < 1) usage_error("--threads must be at least 1");
-        } else if (arg == "--precision") {
-            const std::string_view p = value();
-            if (p == "float") arguments.options.precision = prism::Precision::single;
-            else if (p == "double-refine") arguments.options.precision = prism::Precision::double_refine;
-            else if (p == "double") arguments.options.precision = prism::Precision::double_all;
-            else usage_error("--precision must be float, double-refine or double");
-        } else if (arg == "--scale") {
-            arguments.options.resolution_scale = parse_number<double>(arg, value());
-            if (!(arguments.options.resolution_scale > 0 && arguments.options.resolution_scale <= 1))
-                usage_error("--scale must be in (0, 1]");
         } else if (arg == "--cull-backfaces") {
             arguments.options.cull_backfaces = true;
         } else if (arg == "--quiet") {
             arguments.quiet = true;
         } else if (!arg.empty() && arg[0] == '-') {
-            usage_error("unknown option " + std::string(arg));
+            command_line.usage_error("unknown option " + std::string(arg));
         } else if (arguments.scene.empty()) {
             arguments.scene = std::filesystem::path(arg);
         } else {
-            usage_error("more than one scene given");
+            command_line.usage_error("more than one scene given");
         }
     }
-    if (arguments.scene.empty()) usage_error("no scene given");
+    if (arguments.scene.empty()) command_line.usage_error("no scene given");
     return arguments;
 }
 

@@ -1,6 +1,8 @@
 // prism-suite: renders a set of course scenes (a manifest, or every scene file in a folder),
 // compares each camera's image with its expected image and prints one table row per image,
 // so a renderer is checked against the course in one command and one exit status.
+#include "../common/command_line.hpp"
+
 #include <prism/image/compare.hpp>
 #include <prism/image/image_io.hpp>
 #include <prism/io/load.hpp>
@@ -26,6 +28,8 @@
 namespace fs = std::filesystem;
 
 namespace {
+
+const prism::CommandLine command_line("prism-suite");
 
 constexpr const char* usage = R"(usage: prism-suite (MANIFEST.tsv | FOLDER) [options]
 
@@ -74,11 +78,6 @@ exit status: 0 when nothing failed, 1 when something failed, 2 for usage errors 
 option, a manifest or folder that does not exist, a selection that matches no scene).
 )";
 
-[[noreturn]] void usage_error(const std::string& message) {
-    std::cerr << "prism-suite: " << message << "\n(see prism-suite --help)\n";
-    std::exit(2);
-}
-
 std::string lowercase(std::string text) {
     std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return char(std::tolower(c)); });
     return text;
@@ -93,15 +92,6 @@ std::vector<std::string> split(std::string_view text, char separator) {
         if (end == std::string_view::npos) return parts;
         begin = end + 1;
     }
-}
-
-template <class Number>
-Number parse_number(std::string_view option, std::string_view text) {
-    Number value{};
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (error != std::errc() || end != text.data() + text.size())
-        usage_error(std::string(option) + ": not a number: '" + std::string(text) + "'");
-    return value;
 }
 
 // Confidence levels in the manifest's words; an unknown word ranks lowest.
@@ -129,54 +119,43 @@ Arguments parse_arguments(int argc, char** argv) {
     for (std::size_t i = 0; i < args.size(); ++i) {
         const std::string_view arg = args[i];
         const auto value = [&]() -> std::string_view {
-            if (i + 1 >= args.size()) usage_error(std::string(arg) + " needs a value");
+            if (i + 1 >= args.size()) command_line.usage_error(std::string(arg) + " needs a value");
             return args[++i];
         };
         if (arg == "--help" || arg == "-h") {
             std::cout << usage;
             std::exit(0);
+        } else if (command_line.render_option(arg, value, arguments.options)) {
+            continue;
         } else if (arg == "--topics") {
             arguments.topics = split(value(), ',');
         } else if (arg == "--scene") {
             arguments.scenes = split(value(), ',');
         } else if (arg == "--format") {
             arguments.format = lowercase(std::string(value()));
-            if (arguments.format != "xml" && arguments.format != "json") usage_error("--format must be xml or json");
-        } else if (arg == "--scale") {
-            arguments.options.resolution_scale = parse_number<double>(arg, value());
-            if (!(arguments.options.resolution_scale > 0 && arguments.options.resolution_scale <= 1))
-                usage_error("--scale must be in (0, 1]");
+            if (arguments.format != "xml" && arguments.format != "json") command_line.usage_error("--format must be xml or json");
         } else if (arg == "--threshold") {
-            arguments.threshold = parse_number<double>(arg, value());
-            if (!std::isfinite(arguments.threshold)) usage_error("--threshold must be a finite number of dB");
+            arguments.threshold = command_line.number<double>(arg, value());
+            if (!std::isfinite(arguments.threshold)) command_line.usage_error("--threshold must be a finite number of dB");
         } else if (arg == "--require") {
             const std::string_view level = value();
             if (level == "high") arguments.required_rank = 3;
             else if (level == "medium") arguments.required_rank = 2;
             else if (level == "any") arguments.required_rank = 0;
-            else usage_error("--require must be high, medium or any");
+            else command_line.usage_error("--require must be high, medium or any");
         } else if (arg == "--output-dir") {
             arguments.output_dir = fs::path(value());
-        } else if (arg == "--threads") {
-            arguments.options.threads = parse_number<int>(arg, value());
-            if (arguments.options.threads < 1) usage_error("--threads must be at least 1");
-        } else if (arg == "--precision") {
-            const std::string_view p = value();
-            if (p == "float") arguments.options.precision = prism::Precision::single;
-            else if (p == "double-refine") arguments.options.precision = prism::Precision::double_refine;
-            else if (p == "double") arguments.options.precision = prism::Precision::double_all;
-            else usage_error("--precision must be float, double-refine or double");
         } else if (arg == "--verbose") {
             arguments.verbose = true;
         } else if (!arg.empty() && arg[0] == '-') {
-            usage_error("unknown option " + std::string(arg));
+            command_line.usage_error("unknown option " + std::string(arg));
         } else if (arguments.input.empty()) {
             arguments.input = fs::path(arg);
         } else {
-            usage_error("more than one manifest or folder given");
+            command_line.usage_error("more than one manifest or folder given");
         }
     }
-    if (arguments.input.empty()) usage_error("no manifest or folder given");
+    if (arguments.input.empty()) command_line.usage_error("no manifest or folder given");
     return arguments;
 }
 
@@ -223,7 +202,7 @@ std::vector<Reference> parse_references(const std::string& field, const fs::path
 
 std::vector<Job> read_manifest(const fs::path& manifest) {
     std::ifstream in(manifest);
-    if (!in) usage_error(manifest.string() + ": cannot open the manifest");
+    if (!in) command_line.usage_error(manifest.string() + ": cannot open the manifest");
     std::string line;
     std::vector<std::string> header;
     while (header.empty() && std::getline(in, line)) {
@@ -233,7 +212,7 @@ std::vector<Job> read_manifest(const fs::path& manifest) {
     const auto column = [&](const char* name) {
         const auto found = std::find(header.begin(), header.end(), name);
         if (found == header.end())
-            usage_error(manifest.string() + ": not a manifest (no '" + name + "' column in its first line)");
+            command_line.usage_error(manifest.string() + ": not a manifest (no '" + name + "' column in its first line)");
         return std::size_t(found - header.begin());
     };
     const std::size_t topic = column("topic"), scene = column("scene"), format = column("format"),
@@ -503,19 +482,19 @@ bool selected(const std::vector<std::string>& allowed, const std::string& value)
 int main(int argc, char** argv) {
     const Arguments arguments = parse_arguments(argc, argv);
     std::error_code error;
-    if (!fs::exists(arguments.input, error)) usage_error(arguments.input.string() + ": no such manifest or folder");
+    if (!fs::exists(arguments.input, error)) command_line.usage_error(arguments.input.string() + ": no such manifest or folder");
 
     std::vector<Job> jobs;
     try {
         jobs = fs::is_directory(arguments.input) ? find_scenes(arguments.input) : read_manifest(arguments.input);
     } catch (const fs::filesystem_error& listing_error) {
-        usage_error(listing_error.what());
+        command_line.usage_error(listing_error.what());
     }
     std::erase_if(jobs, [&](const Job& job) {
         return !selected(arguments.topics, job.topic) || !selected(arguments.scenes, job.scene) ||
                (!arguments.format.empty() && job.format != arguments.format);
     });
-    if (jobs.empty()) usage_error(arguments.input.string() + ": no scene matches the selection");
+    if (jobs.empty()) command_line.usage_error(arguments.input.string() + ": no scene matches the selection");
 
     // Widths from what is known before rendering; an unexpectedly long image name only widens its
     // own row.

@@ -1,0 +1,60 @@
+// What the example programs share on their command lines: a usage error is one line on stderr
+// and exit status 2, numbers parse whole or not at all, and every program that renders takes the
+// same --threads, --precision and --scale with the same checks.
+#pragma once
+
+#include <prism/render/render_scene.hpp>
+
+#include <charconv>
+#include <cstdlib>
+#include <iostream>
+#include <string>
+#include <string_view>
+
+namespace prism {
+
+class CommandLine {
+public:
+    explicit CommandLine(std::string_view program) : program_(program) {}
+
+    [[noreturn]] void usage_error(const std::string& message) const {
+        std::cerr << program_ << ": " << message << "\n(see " << program_ << " --help)\n";
+        std::exit(2);
+    }
+
+    template <class Number>
+    Number number(std::string_view option, std::string_view text) const {
+        Number value{};
+        const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+        if (error != std::errc() || end != text.data() + text.size())
+            usage_error(std::string(option) + ": not a number: '" + std::string(text) + "'");
+        return value;
+    }
+
+    // Reads `option` into `options` when it is one of the rendering options, taking its value
+    // from next_value(); returns whether it was.
+    template <class NextValue>
+    bool render_option(std::string_view option, NextValue&& next_value, RenderOptions& options) const {
+        if (option == "--threads") {
+            options.threads = number<int>(option, next_value());
+            if (options.threads < 1) usage_error("--threads must be at least 1");
+        } else if (option == "--precision") {
+            const std::string_view precision = next_value();
+            if (precision == "float") options.precision = Precision::single;
+            else if (precision == "double-refine") options.precision = Precision::double_refine;
+            else if (precision == "double") options.precision = Precision::double_all;
+            else usage_error("--precision must be float, double-refine or double");
+        } else if (option == "--scale") {
+            options.resolution_scale = number<double>(option, next_value());
+            if (!(options.resolution_scale > 0 && options.resolution_scale <= 1)) usage_error("--scale must be in (0, 1]");
+        } else {
+            return false;
+        }
+        return true;
+    }
+
+private:
+    std::string_view program_;
+};
+
+}  // namespace prism
