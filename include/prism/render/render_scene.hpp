@@ -30,11 +30,12 @@ namespace prism {
 
 enum class Precision { single, double_refine, double_all };
 
-inline const char* to_string(Precision precision) {
+// The geometry a precision builds, as the renderer reports its configuration.
+inline const char* describe(Precision precision) {
     switch (precision) {
-        case Precision::single: return "float";
-        case Precision::double_refine: return "double-refine";
-        case Precision::double_all: return "double";
+        case Precision::single: return "float BVH, watertight triangle tests";
+        case Precision::double_refine: return "float BVH, double-precision watertight triangle tests";
+        case Precision::double_all: return "double BVH, watertight triangle tests";
     }
     return "?";
 }
@@ -157,10 +158,7 @@ inline std::vector<CameraImage> render_scene(
     const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
     tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
     const Choice choice = choose_precision(scene, options);
-    static constexpr const char* geometry_of[] = {"float BVH, watertight triangle tests",
-                                                  "float BVH, double-precision watertight triangle tests",
-                                                  "double BVH, watertight triangle tests"};
-    log << "configuration: " << geometry_of[int(choice.precision)] << ", "
+    log << "configuration: " << describe(choice.precision) << ", "
         << (needs_punctual_lights(scene) ? "point, directional and spot lights" : "point lights") << " ("
         << choice.reason << ")\n";
     switch (choice.precision) {

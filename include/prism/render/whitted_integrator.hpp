@@ -53,7 +53,8 @@ public:
             color += direct_lighting(point.position, normal, -d, material);
         }
 
-        if (depth < settings_.max_recursion_depth) {
+        // Blinn-Phong surfaces spawn no rays; the others reflect (and dielectrics refract).
+        if (depth < settings_.max_recursion_depth && material.type != scene::MaterialType::blinn_phong) {
             using scene::MaterialType;
             const Real cos_incident = -glm::dot(d, normal);
             const Vec3<Real> reflected = d + 2 * cos_incident * normal;
