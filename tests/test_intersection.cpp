@@ -2,6 +2,7 @@
 // triangle intersectors (Watertight and NaiveEpsilon) including the edge and vertex cases that
 // make a test watertight or not, the AABB slab test the BVH relies on, and the floating-point
 // helpers (gamma, next_up, next_down) whose double overloads must not be float-sized.
+#include "intersector_variants.hpp"
 #include <prism/geometry/aabb.hpp>
 #include <prism/geometry/naive_epsilon.hpp>
 #include <prism/geometry/sphere.hpp>
@@ -20,16 +21,7 @@
 
 namespace {
 
-// One test case per (intersector, scalar) pair, so a failure names both.
-template <class IntersectorT, class RealT>
-struct Variant {
-    using Intersector = IntersectorT;
-    using Real = RealT;
-};
-using WatertightFloat = Variant<prism::Watertight, float>;
-using WatertightDouble = Variant<prism::Watertight, double>;
-using NaiveFloat = Variant<prism::NaiveEpsilon, float>;
-using NaiveDouble = Variant<prism::NaiveEpsilon, double>;
+using namespace prism_test;  // the intersector variants
 
 // Relative tolerance for values the intersectors compute with a handful of roundings.
 template <class Real>

@@ -4,6 +4,7 @@
 // whole SceneGeometry and BVH. A closed surface around the ray origin is always hit: Watertight
 // and DoubleRefine miss none; NaiveEpsilon (Moeller-Trumbore with fixed epsilons) is reported,
 // and must miss at the tiny scale, where its fixed area threshold rejects every triangle.
+#include "intersector_variants.hpp"
 #include <prism/accel/accelerator.hpp>
 #include <prism/geometry/double_refine.hpp>
 #include <prism/geometry/naive_epsilon.hpp>
@@ -28,16 +29,7 @@
 
 namespace {
 
-template <class IntersectorT, class RealT>
-struct LeakVariant {
-    using Intersector = IntersectorT;
-    using Real = RealT;
-};
-using LeakWatertightFloat = LeakVariant<prism::Watertight, float>;
-using LeakWatertightDouble = LeakVariant<prism::Watertight, double>;
-using LeakDoubleRefineFloat = LeakVariant<prism::DoubleRefine, float>;
-using LeakNaiveFloat = LeakVariant<prism::NaiveEpsilon, float>;
-using LeakNaiveDouble = LeakVariant<prism::NaiveEpsilon, double>;
+using namespace prism_test;  // the intersector variants
 
 struct LeakCase {
     double offset;  // the centre is (offset, offset, offset): every coordinate that large
@@ -207,14 +199,14 @@ void report(const std::array<CaseResult, leak_cases.size()>& results) {
 
 }  // namespace
 
-TYPE_TO_STRING(LeakWatertightFloat);
-TYPE_TO_STRING(LeakWatertightDouble);
-TYPE_TO_STRING(LeakDoubleRefineFloat);
-TYPE_TO_STRING(LeakNaiveFloat);
-TYPE_TO_STRING(LeakNaiveDouble);
+TYPE_TO_STRING(WatertightFloat);
+TYPE_TO_STRING(WatertightDouble);
+TYPE_TO_STRING(DoubleRefineFloat);
+TYPE_TO_STRING(NaiveFloat);
+TYPE_TO_STRING(NaiveDouble);
 
 TEST_CASE_TEMPLATE("leak test: Watertight and DoubleRefine lose no ray aimed at a vertex or an edge", V,
-                   LeakWatertightFloat, LeakWatertightDouble, LeakDoubleRefineFloat) {
+                   WatertightFloat, WatertightDouble, DoubleRefineFloat) {
     const auto results = run_all_cases<V>();
     report<V>(results);
     int cases_run = 0;
@@ -228,8 +220,8 @@ TEST_CASE_TEMPLATE("leak test: Watertight and DoubleRefine lose no ray aimed at 
     CHECK(cases_run == int(leak_cases.size()));
 }
 
-TEST_CASE_TEMPLATE("leak test: NaiveEpsilon's misses, and its failure at the tiny scale", V, LeakNaiveFloat,
-                   LeakNaiveDouble) {
+TEST_CASE_TEMPLATE("leak test: NaiveEpsilon's misses, and its failure at the tiny scale", V, NaiveFloat,
+                   NaiveDouble) {
     const auto results = run_all_cases<V>();
     report<V>(results);
     // At radius 1e-3 the triangles' edges are ~6.6e-5 long, so |n|^2 = |e1 x e2|^2 ~ 1e-17 is

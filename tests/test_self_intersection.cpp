@@ -4,6 +4,7 @@
 // triangles with coordinates log-uniform in 1e-8..1e8, rays spawned from their hits with the
 // error-bound offset never hit the same triangle again, while a fixed 1e-4 offset does; then the
 // same protocol for instanced triangles through SceneGeometry.
+#include "intersector_variants.hpp"
 #include <prism/accel/accelerator.hpp>
 #include <prism/geometry/double_refine.hpp>
 #include <prism/geometry/scene_geometry.hpp>
@@ -22,14 +23,7 @@
 
 namespace {
 
-template <class IntersectorT, class RealT>
-struct SpawnVariant {
-    using Intersector = IntersectorT;
-    using Real = RealT;
-};
-using SpawnWatertightFloat = SpawnVariant<prism::Watertight, float>;
-using SpawnWatertightDouble = SpawnVariant<prism::Watertight, double>;
-using SpawnDoubleRefineFloat = SpawnVariant<prism::DoubleRefine, float>;
+using namespace prism_test;  // the intersector variants
 
 using Wide = long double;  // the reference precision (x87: 64-bit significand) for the helper tests
 using WideVec3 = glm::vec<3, Wide, glm::defaultp>;
@@ -183,9 +177,9 @@ ReintersectCounts reintersect(int triangle_count, int rays_per_triangle, std::ui
 
 }  // namespace
 
-TYPE_TO_STRING(SpawnWatertightFloat);
-TYPE_TO_STRING(SpawnWatertightDouble);
-TYPE_TO_STRING(SpawnDoubleRefineFloat);
+TYPE_TO_STRING(WatertightFloat);
+TYPE_TO_STRING(WatertightDouble);
+TYPE_TO_STRING(DoubleRefineFloat);
 
 // ---------------------------------------------------------------------------------------------
 // The helpers, each against a reference in long double.
@@ -373,15 +367,15 @@ const ReintersectCounts& reintersect_counts() {
 
 // What the offset itself promises, whatever the intersector: the origin lies strictly on the
 // side it was pushed to, measured against the exact plane of the stored vertices.
-TEST_CASE_TEMPLATE("the spawn origin lies strictly on its side of the exact plane", V, SpawnWatertightFloat,
-                   SpawnWatertightDouble, SpawnDoubleRefineFloat) {
+TEST_CASE_TEMPLATE("the spawn origin lies strictly on its side of the exact plane", V, WatertightFloat,
+                   WatertightDouble, DoubleRefineFloat) {
     CHECK(reintersect_counts<V>().origins_behind == 0);
 }
 
 // pbrt's hit-point bound alone is reported, not asserted: it leaves a few re-hits where a
 // triangle is large next to its distance from the origin (see triangle_spawn_point).
-TEST_CASE_TEMPLATE("rays spawned from triangle_spawn_point never re-hit their triangle", V, SpawnWatertightFloat,
-                   SpawnWatertightDouble, SpawnDoubleRefineFloat) {
+TEST_CASE_TEMPLATE("rays spawned from triangle_spawn_point never re-hit their triangle", V, WatertightFloat,
+                   WatertightDouble, DoubleRefineFloat) {
     const ReintersectCounts& counts = reintersect_counts<V>();
     MESSAGE(counts.triangles, " triangles, ", counts.incoming_hits, " hits, ", counts.spawned,
             " spawned rays; re-hits: triangle_spawn_point ", counts.bound_rehits, ", pbrt's hit-point bound alone ",
@@ -398,7 +392,7 @@ TEST_CASE_TEMPLATE("rays spawned from triangle_spawn_point never re-hit their tr
 // way: from triangles narrower than 1e-4 it starts the ray beyond anything that thin, skipping
 // the other side of a thin shell.
 TEST_CASE_TEMPLATE("a fixed 1e-4 offset along the normal re-hits in float and overshoots small triangles", V,
-                   SpawnWatertightFloat, SpawnWatertightDouble, SpawnDoubleRefineFloat) {
+                   WatertightFloat, WatertightDouble, DoubleRefineFloat) {
     const ReintersectCounts& counts = reintersect_counts<V>();
     MESSAGE("fixed 1e-4 offset: ", counts.epsilon_rehits, " re-hits and ", counts.epsilon_overshoots,
             " origins beyond a triangle narrower than the offset, of ", counts.spawned, " spawned rays");
@@ -526,7 +520,7 @@ InstancedCounts reintersect_instanced(int triangle_count, int rays_per_triangle,
 // The world-space count shows why InstanceTransforms exists: pbrt's transform_point bound, offset
 // in world space, misses the round trip back into object space.
 TEST_CASE_TEMPLATE("instanced triangles: rays spawned with the InstanceTransforms offset never re-hit", V,
-                   SpawnWatertightFloat, SpawnWatertightDouble, SpawnDoubleRefineFloat) {
+                   WatertightFloat, WatertightDouble, DoubleRefineFloat) {
     const InstancedCounts counts = reintersect_instanced<typename V::Intersector, typename V::Real>(300, 1000, 31);
     MESSAGE(counts.incoming_hits, " hits, ", counts.spawned, " spawned rays; re-hits: InstanceTransforms offset ",
             counts.instance_rehits, ", world-space bound (pbrt's transform_point) ", counts.world_rehits);
