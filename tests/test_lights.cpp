@@ -76,7 +76,7 @@ TEST_CASE_TEMPLATE("DirectionalLight: towards the light, infinitely far, no fall
     CHECK(prism::DirectionalLight<Real>::count_in(world) == 1);
     const glm::dvec3 towards = -glm::normalize(glm::dvec3(1, -0.8, -1));
     for (const auto& point : {prism::Vec3<Real>(0), prism::Vec3<Real>(1000, -5, 3)}) {
-        const prism::LightSample<Real> sample = lights[0].sample(point);
+        const prism::LightSample<Real> sample = lights[0].sample({point});
         CHECK(std::isinf(sample.distance));
         for (int c = 0; c < 3; ++c) CHECK(sample.direction[c] == doctest::Approx(towards[c]).epsilon(1e-6));
         CHECK(glm::dvec3(sample.radiance) == glm::dvec3(200, 150, 100));
@@ -91,7 +91,7 @@ TEST_CASE_TEMPLATE("SpotLight: inside, across and outside the cone, with inverse
         for (double alpha = 0; alpha <= 40; alpha += 0.5) {
             CAPTURE(distance);
             CAPTURE(alpha);
-            const prism::LightSample<Real> sample = spot.sample(point_at<Real>(alpha, distance));
+            const prism::LightSample<Real> sample = spot.sample({point_at<Real>(alpha, distance)});
             CHECK(sample.distance == doctest::Approx(distance).epsilon(1e-6));
             const glm::dvec3 expected = intensity * course_spot_factor(alpha, 60, 40) / (distance * distance);
             for (int c = 0; c < 3; ++c) CHECK(double(sample.radiance[c]) == doctest::Approx(expected[c]).epsilon(1e-4).scale(1e-3));
@@ -102,10 +102,10 @@ TEST_CASE_TEMPLATE("SpotLight: inside, across and outside the cone, with inverse
     }
     // By hand, halfway between the edges (alpha 25): ((cos 25 - cos 30) / (cos 20 - cos 30))^4
     // = (0.040276 / 0.073667)^4 = 0.089353; at distance 2, 400 / 4 times that.
-    CHECK(double(spot.sample(point_at<Real>(25, 2)).radiance.r) == doctest::Approx(100 * 0.089353).epsilon(1e-3));
-    CHECK(double(spot.sample(point_at<Real>(10, 2)).radiance.r) == doctest::Approx(100).epsilon(1e-5));
-    CHECK(spot.sample(point_at<Real>(31, 2)).radiance == prism::Vec3<Real>(0));
-    CHECK(spot.sample(point_at<Real>(150, 2)).radiance == prism::Vec3<Real>(0));  // behind the light
+    CHECK(double(spot.sample({point_at<Real>(25, 2)}).radiance.r) == doctest::Approx(100 * 0.089353).epsilon(1e-3));
+    CHECK(double(spot.sample({point_at<Real>(10, 2)}).radiance.r) == doctest::Approx(100).epsilon(1e-5));
+    CHECK(spot.sample({point_at<Real>(31, 2)}).radiance == prism::Vec3<Real>(0));
+    CHECK(spot.sample({point_at<Real>(150, 2)}).radiance == prism::Vec3<Real>(0));  // behind the light
 }
 
 TEST_CASE_TEMPLATE("SpotLight: no ring at the falloff edge or the coverage edge", Real, float, double) {
@@ -113,7 +113,7 @@ TEST_CASE_TEMPLATE("SpotLight: no ring at the falloff edge or the coverage edge"
         CAPTURE(coverage);
         CAPTURE(falloff);
         const auto spot = prism::SpotLight<Real>::from_description(downward_spot(coverage, falloff));
-        const auto factor = [&](double alpha) { return double(spot.sample(point_at<Real>(alpha, 1)).radiance.r) / 400; };
+        const auto factor = [&](double alpha) { return double(spot.sample({point_at<Real>(alpha, 1)}).radiance.r) / 400; };
         // The factor's slope just outside the falloff edge is 4 sin(falloff/2) / (cos(falloff/2) -
         // cos(coverage/2)) per radian, 204 for the course's 10/8 degree cone: a step of 1e-6
         // degrees moves a continuous factor by 4e-6, so a larger jump is a ring.
@@ -135,8 +135,8 @@ TEST_CASE_TEMPLATE("SpotLight: no ring at the falloff edge or the coverage edge"
 TEST_CASE_TEMPLATE("SpotLight: equal angles make a hard edge without dividing by zero", Real, float, double) {
     const auto spot = prism::SpotLight<Real>::from_description(downward_spot(40, 40));
     CHECK(double(spot.falloff(spot.cos_half_falloff)) == 1.0);
-    CHECK(double(spot.sample(point_at<Real>(19.9, 1)).radiance.r) == doctest::Approx(400));
-    CHECK(double(spot.sample(point_at<Real>(20.1, 1)).radiance.r) == 0.0);
+    CHECK(double(spot.sample({point_at<Real>(19.9, 1)}).radiance.r) == doctest::Approx(400));
+    CHECK(double(spot.sample({point_at<Real>(20.1, 1)}).radiance.r) == 0.0);
 }
 
 namespace {

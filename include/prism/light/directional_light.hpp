@@ -22,7 +22,7 @@ struct DirectionalLight {
         return lights;
     }
 
-    LightSample<Real> sample(const Vec3<Real>&) const { return {to_light, infinity<Real>, radiance}; }
+    LightSample<Real> sample(const ShadingFrame<Real>&, const Vec2<Real>& = {}) const { return {to_light, infinity<Real>, radiance}; }
 };
 
 }  // namespace prism

@@ -1,5 +1,9 @@
 // What a light tells a shading point: where the light comes from, how far the shadow ray must
 // reach, and the radiance-like quantity arriving (irradiance on a surface facing the light).
+// Lights that are not a point or a direction (area, environment) are sampled: `u` is a uniform
+// point of [0, 1)^2 from the pixel's random stream, and the sample's radiance is already the
+// Monte Carlo estimate (divided by the probability density of the chosen direction), so the
+// integrator treats every light alike.
 #pragma once
 
 #include <prism/math/vector.hpp>
@@ -17,11 +21,20 @@ struct LightSample {
     Vec3<Real> radiance{0};   // arriving at the point, before the cosine and the BRDF
 };
 
+// Where a light is seen from: the shading point and its unit normal on the side the ray came
+// from (hemisphere samplers need it; punctual lights ignore it).
+template <Scalar Real>
+struct ShadingFrame {
+    Vec3<Real> position{0};
+    Vec3<Real> normal{0, 0, 1};
+};
+
 // A light type: built from the plain scene, sampled from a shading point. No virtual calls:
 // LightSet loops over each type's vector with a fold expression.
 template <class L, class Real>
-concept Light = Scalar<Real> && requires(const L& light, const Vec3<Real>& point, const scene::Scene& scene) {
-    { light.sample(point) } -> std::same_as<LightSample<Real>>;
+concept Light = Scalar<Real> && requires(const L& light, const ShadingFrame<Real>& at, const Vec2<Real>& u,
+                                         const scene::Scene& scene) {
+    { light.sample(at, u) } -> std::same_as<LightSample<Real>>;
     { L::from_scene(scene) } -> std::same_as<std::vector<L>>;
     { L::count_in(scene) } -> std::convertible_to<std::size_t>;
 };

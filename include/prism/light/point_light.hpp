@@ -20,8 +20,8 @@ struct PointLight {
         return lights;
     }
 
-    LightSample<Real> sample(const Vec3<Real>& point) const {
-        const Vec3<Real> to_light = position - point;
+    LightSample<Real> sample(const ShadingFrame<Real>& at, const Vec2<Real>& = {}) const {
+        const Vec3<Real> to_light = position - at.position;
         const Real distance_squared = glm::dot(to_light, to_light);
         const Real distance = std::sqrt(distance_squared);
         return {to_light / distance, distance, intensity / distance_squared};

@@ -49,8 +49,8 @@ struct SpotLight {
         return s2 * s2;
     }
 
-    LightSample<Real> sample(const Vec3<Real>& point) const {
-        const Vec3<Real> to_light = position - point;
+    LightSample<Real> sample(const ShadingFrame<Real>& at, const Vec2<Real>& = {}) const {
+        const Vec3<Real> to_light = position - at.position;
         const Real distance_squared = glm::dot(to_light, to_light);
         const Real distance = std::sqrt(distance_squared);
         const Vec3<Real> direction = to_light / distance;

@@ -88,7 +88,7 @@ private:
         Vec3<Real> color(0);
         const Vec3<Real> shadow_origin = position + normal * epsilon_;
         lights_.for_each([&](const auto& light) {
-            const LightSample<Real> sample = light.sample(position);
+            const LightSample<Real> sample = light.sample({position, normal});
             const Real cos_light = glm::dot(normal, sample.direction);
             if (cos_light <= 0) return;
             // The shadow ray leaves the offset origin aimed at the light, and anything nearer than

@@ -3,6 +3,8 @@
 // user can also build one in code (examples/minimal) without any file format.
 #pragma once
 
+#include <prism/image/image.hpp>
+
 #include <glm/glm.hpp>
 
 #include <array>
@@ -17,6 +19,10 @@ namespace prism::scene {
 using Vec2 = glm::dvec2;
 using Vec3 = glm::dvec3;
 using Mat4 = glm::dmat4;  // column-major, as GLM; applied to column vectors (p' = M p)
+
+// How a pixel's samples are weighted: equally (box), or by a Gaussian of their distance from the
+// pixel centre (standard deviation 1/2 pixel, cut off at the pixel's border).
+enum class PixelFilter { box, gaussian };
 
 enum class TonemapOperator { photographic, aces, filmic };
 
@@ -47,7 +53,12 @@ struct Camera {
     std::string image_name;  // as written in the file; relative to the output folder
     // handedness="left" mirrors the image horizontally: u = gaze x up instead of up x w.
     bool left_handed = false;
+    // Multisampling (camera/pixel_sampler.hpp): NumSamples jittered samples per pixel, weighted
+    // by the reconstruction filter.
     int num_samples = 1;
+    PixelFilter filter = PixelFilter::box;
+    // Thin lens: a square aperture of side ApertureSize, sharp at FocusDistance along the gaze.
+    // Zero aperture: the pinhole.
     double aperture_size = 0.0;
     double focus_distance = 0.0;
     // One LDR image per entry, all from the one HDR render (image/tonemap.hpp); none: a .png
@@ -81,7 +92,35 @@ struct SpotLight {
     double falloff_angle = 0.0;
 };
 
-// Later topics' lights (area, environment) are added by their issues.
+// A one-sided parallelogram emitter seen from both sides, as the course defines it: a point is
+// lit through a random point of the parallelogram corner + s edge1 + t edge2 (s, t in [0, 1]).
+// The 2019+ form (Position = centre, Normal, Size = side of a square, Radiance) is turned into
+// this one by the loader; `radiance` is the emitted radiance in both forms (the 2017-2018
+// form's Intensity is a radiance too: its irradiance is Intensity * area * cos / d^2).
+struct AreaLight {
+    std::string id;
+    Vec3 corner{0.0};
+    Vec3 edge1{1.0, 0.0, 0.0};
+    Vec3 edge2{0.0, 0.0, 1.0};
+    Vec3 radiance{0.0};
+};
+
+enum class EnvironmentLayout { latlong, probe };
+// How an environment light picks its directions: uniformly over the hemisphere around the
+// normal, cosine-weighted over it (both as the course defines them), or in proportion to the
+// image's luminance (beyond the course).
+enum class EnvironmentSampling { uniform, cosine, importance };
+
+// The course's SphericalDirectionalLight: an HDR image around the scene, in lat-long or
+// light-probe layout. It lights every point (sampled per shading point) and is the background
+// for rays that escape.
+struct EnvironmentLight {
+    std::string id;
+    std::size_t image = 0;  // index into Scene::images
+    EnvironmentLayout layout = EnvironmentLayout::latlong;
+    EnvironmentSampling sampling = EnvironmentSampling::cosine;
+    Vec3 scale{1.0};  // multiplies the image's radiance
+};
 
 enum class MaterialType { blinn_phong, mirror, conductor, dielectric };
 
@@ -100,8 +139,51 @@ struct Material {
     // the refracted ray. Zero elsewhere.
     Vec3 transparency{0.0};
     double roughness = 0.0;
+    // The reflectances are sRGB-encoded colours: the loader has already linearised them with
+    // pow(c, 2.2) when this is set (it is kept for the record).
     bool degamma = false;
 };
+
+// An image a texture or an environment light reads, decoded once by the loader into linear
+// float RGB as stored in the file (no normalisation: an 8-bit file keeps 0..255, an HDR file
+// its radiance), so that bad or missing files fail at load time, naming the element.
+struct TextureImage {
+    std::filesystem::path path;  // as resolved, for messages
+    Image pixels;
+    bool high_dynamic_range = false;  // .hdr / .exr
+};
+
+enum class TextureKind { image, perlin, checkerboard };
+enum class Interpolation { nearest, bilinear, trilinear };
+enum class DecalMode { replace_kd, blend_kd, replace_ks, replace_background, replace_normal, bump_normal, replace_all };
+// Perlin noise to a value in [0, 1]: |n| (absval, the course's "patch" look) or (n + 1) / 2
+// (linear, "vein" when used with the 2019 Appearance element).
+enum class NoiseConversion { absval, linear };
+
+// One texture of the course, in either schema (2020+ <Textures><Images/><TextureMap/></Textures>
+// or the older <Texture><ImageName/></Texture>): what it reads, how it is looked up, what it
+// replaces. Fields unused by a kind keep their defaults.
+struct Texture {
+    std::string id;
+    TextureKind kind = TextureKind::image;
+    DecalMode decal_mode = DecalMode::replace_kd;
+    // image
+    std::size_t image = 0;  // index into Scene::images
+    Interpolation interpolation = Interpolation::bilinear;
+    double normalizer = 255.0;  // texel / normalizer is the value in [0, 1] (LDR images)
+    bool degamma = false;       // sRGB texels: linearise (pow 2.2) after normalising
+    double bump_factor = 1.0;   // scales the height for bump_normal
+    // perlin
+    NoiseConversion noise_conversion = NoiseConversion::absval;
+    double noise_scale = 1.0;  // the point is multiplied by it before the noise is taken
+    int num_octaves = 1;
+    // checkerboard
+    double scale = 1.0;
+    double offset = 0.0;
+    Vec3 black_color{0.0};
+    Vec3 white_color{1.0};
+};
+
 
 enum class ShadingMode { flat, smooth };
 
@@ -117,6 +199,8 @@ struct Mesh {
     std::vector<Vec2> uvs;      // per vertex, optional
     std::vector<std::array<std::uint32_t, 3>> triangles;
     Mat4 transform{1.0};  // object to world
+    std::vector<std::size_t> textures;  // indices into Scene::textures, in the file's order
+    Vec3 motion{0.0};  // MotionBlur: the world-space translation over the shutter interval
 };
 
 struct Sphere {
@@ -125,6 +209,8 @@ struct Sphere {
     Vec3 center{0.0};
     double radius = 1.0;
     Mat4 transform{1.0};
+    std::vector<std::size_t> textures;
+    Vec3 motion{0.0};
 };
 
 struct Plane {
@@ -133,6 +219,7 @@ struct Plane {
     Vec3 point{0.0};
     Vec3 normal{0.0, 1.0, 0.0};
     Mat4 transform{1.0};
+    std::vector<std::size_t> textures;
 };
 
 // A mesh instance shares its base mesh's geometry (and its BVH); `transform` is already the
@@ -143,6 +230,8 @@ struct MeshInstance {
     std::size_t base_mesh = 0;  // index into Scene::meshes
     std::size_t material = 0;
     Mat4 transform{1.0};
+    std::vector<std::size_t> textures;  // the instance's own, else the base mesh's
+    Vec3 motion{0.0};
 };
 
 struct Scene {
@@ -160,11 +249,19 @@ struct Scene {
     std::vector<PointLight> point_lights;
     std::vector<DirectionalLight> directional_lights;
     std::vector<SpotLight> spot_lights;
+    std::vector<AreaLight> area_lights;
+    std::vector<EnvironmentLight> environment_lights;
     std::vector<Material> materials;
     std::vector<Mesh> meshes;
     std::vector<Sphere> spheres;
     std::vector<Plane> planes;
     std::vector<MeshInstance> mesh_instances;
+
+    std::vector<TextureImage> images;
+    std::vector<Texture> textures;
+    // A texture with DecalMode replace_background: looked up at the pixel's (u, v) in [0, 1]^2
+    // for primary rays that escape, instead of BackgroundColor.
+    std::optional<std::size_t> background_texture;
 
     // Elements of the file that this version does not render (e.g. "AreaLight"), one entry per
     // distinct name, so that the renderer can say what it leaves out instead of hiding it.
