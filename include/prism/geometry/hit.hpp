@@ -5,6 +5,7 @@
 #include <prism/math/vector.hpp>
 
 #include <cstdint>
+#include <span>
 
 namespace prism {
 
@@ -24,7 +25,13 @@ struct SurfacePoint {
     Vec3<Real> geometric_normal{0};  // unit, world space, as the surface is oriented (not flipped)
     Vec3<Real> shading_normal{0};    // unit; interpolated for smooth meshes
     Vec2<Real> uv{0};
+    // World-space derivatives of the position along u and v (not unit): the tangent frame of
+    // normal and bump maps. Zero where the surface has no (u, v): meshes without texture
+    // coordinates, planes.
+    Vec3<Real> dpdu{0}, dpdv{0};
+    Vec3<Real> local_position{0};  // in the object's own space: where solid textures are evaluated
     std::uint32_t material = 0;
+    std::span<const std::uint32_t> textures;  // the object's textures (indices into Scene::textures)
 };
 
 }  // namespace prism

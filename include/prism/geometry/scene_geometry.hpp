@@ -41,15 +41,15 @@ public:
         for (const auto& mesh : scene.meshes) {
             meshes_.emplace_back(mesh);
             add_instance(Kind::mesh, std::uint32_t(meshes_.size() - 1), mesh.material, mesh.transform,
-                         meshes_.back().bounds());
+                         meshes_.back().bounds(), mesh.textures);
         }
         for (const auto& instance : scene.mesh_instances)
             add_instance(Kind::mesh, std::uint32_t(instance.base_mesh), instance.material, instance.transform,
-                         meshes_[instance.base_mesh].bounds());
+                         meshes_[instance.base_mesh].bounds(), instance.textures);
         for (const auto& sphere : scene.spheres) {
             spheres_.push_back({Vec3<Real>(sphere.center), Real(sphere.radius)});
             add_instance(Kind::sphere, std::uint32_t(spheres_.size() - 1), sphere.material, sphere.transform,
-                         spheres_.back().bounds());
+                         spheres_.back().bounds(), sphere.textures);
         }
         // Planes are unbounded, so they stay outside the top-level index and are tested always.
         for (const auto& plane : scene.planes) {
@@ -58,6 +58,7 @@ public:
                 glm::normalize(glm::transpose(glm::inverse(glm::dmat3(plane.transform))) * plane.normal);
             planes_.push_back({Vec3<Real>(point), Vec3<Real>(normal)});
             plane_materials_.push_back(std::uint32_t(plane.material));
+            plane_textures_.push_back(add_texture_list(plane.textures));
         }
         std::vector<Aabb<Real>> boxes;
         boxes.reserve(instances_.size());
@@ -128,22 +129,29 @@ public:
         if (hit.object >= instances_.size()) {
             const std::size_t p = hit.object - instances_.size();
             point.geometric_normal = point.shading_normal = planes_[p].normal;
+            point.local_position = point.position;
             point.material = plane_materials_[p];
+            point.textures = texture_lists_[plane_textures_[p]];
             return point;
         }
         const Instance& instance = instances_[hit.object];
         point.material = instance.material;
+        point.textures = texture_lists_[instance.textures];
+        point.local_position = instance.transformed ? instance.to_object(point.position) : point.position;
         Vec3<Real> geometric_normal, shading_normal;
         if (instance.kind == Kind::mesh) {
-            meshes_[instance.shape].surface(hit, geometric_normal, shading_normal, point.uv);
+            meshes_[instance.shape].surface(hit, geometric_normal, shading_normal, point.uv, point.dpdu, point.dpdv);
         } else {
             const SphereShape<Real>& sphere = spheres_[instance.shape];
-            const Vec3<Real> local = instance.transformed ? instance.to_object(point.position) : point.position;
-            geometric_normal = shading_normal = glm::normalize(local - sphere.center);
+            geometric_normal = shading_normal = glm::normalize(point.local_position - sphere.center);
+            sphere.parametrise(point.local_position, point.uv, point.dpdu, point.dpdv);
         }
         if (instance.transformed) {
             geometric_normal = glm::normalize(instance.normal_to_world * geometric_normal);
             shading_normal = glm::normalize(instance.normal_to_world * shading_normal);
+            // Tangents are directions on the surface: they map by the linear part itself.
+            point.dpdu = instance.object_to_world_linear * point.dpdu;
+            point.dpdv = instance.object_to_world_linear * point.dpdv;
         }
         point.geometric_normal = geometric_normal;
         point.shading_normal = shading_normal;
@@ -161,6 +169,8 @@ private:
         Mat4<Real> world_to_object{1};
         Mat3<Real> world_to_object_linear{1};
         Mat3<Real> normal_to_world{1};
+        Mat3<Real> object_to_world_linear{1};
+        std::uint32_t textures = 0;  // index into texture_lists_
         Aabb<Real> world_bounds;
 
         Vec3<Real> to_object(const Vec3<Real>& p) const { return Vec3<Real>(world_to_object * Vec4<Real>(p, 1)); }
@@ -171,8 +181,9 @@ private:
     };
 
     void add_instance(Kind kind, std::uint32_t shape, std::size_t material, const glm::dmat4& transform,
-                      const Aabb<Real>& object_bounds) {
+                      const Aabb<Real>& object_bounds, const std::vector<std::size_t>& textures) {
         Instance instance;
+        instance.textures = add_texture_list(textures);
         instance.kind = kind;
         instance.shape = shape;
         instance.material = std::uint32_t(material);
@@ -183,6 +194,7 @@ private:
             instance.world_to_object = Mat4<Real>(inverse);
             instance.world_to_object_linear = Mat3<Real>(glm::dmat3(inverse));
             instance.normal_to_world = Mat3<Real>(glm::transpose(glm::dmat3(inverse)));
+            instance.object_to_world_linear = Mat3<Real>(glm::dmat3(transform));
             for (int c = 0; c < 8; ++c)
                 instance.world_bounds.extend(
                     Vec3<Real>(transform * glm::dvec4(glm::dvec3(object_bounds.corner(c)), 1.0)));
@@ -190,6 +202,12 @@ private:
             instance.world_bounds = object_bounds;
         }
         instances_.push_back(instance);
+    }
+
+    std::uint32_t add_texture_list(const std::vector<std::size_t>& textures) {
+        if (textures.empty()) return 0;
+        texture_lists_.emplace_back(textures.begin(), textures.end());
+        return std::uint32_t(texture_lists_.size() - 1);
     }
 
     template <bool CullBackfaces>
@@ -215,6 +233,9 @@ private:
     std::vector<SphereShape<Real>> spheres_;
     std::vector<PlaneShape<Real>> planes_;
     std::vector<std::uint32_t> plane_materials_;
+    std::vector<std::uint32_t> plane_textures_;
+    // Each object's texture indices; entry 0 is the empty list that untextured objects share.
+    std::vector<std::vector<std::uint32_t>> texture_lists_{1};
     std::vector<Instance> instances_;
     Index top_;
 };

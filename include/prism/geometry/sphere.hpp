@@ -5,6 +5,7 @@
 
 #include <prism/geometry/aabb.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 namespace prism {
@@ -42,6 +43,18 @@ struct SphereShape {
             return true;
         }
         return false;
+    }
+
+    // The course's spherical texture coordinates of a point on the sphere (object space):
+    // u = (pi - atan2(z, x)) / 2 pi, v = acos(y / r) / pi, with the position's derivatives along
+    // them (not unit), which orient normal and bump maps.
+    void parametrise(const Vec3<Real>& point, Vec2<Real>& uv, Vec3<Real>& dpdu, Vec3<Real>& dpdv) const {
+        const Vec3<Real> d = point - center;
+        const Real theta = std::acos(std::clamp(d.y / radius, Real(-1), Real(1)));
+        const Real phi = std::atan2(d.z, d.x);
+        uv = {(pi<Real> - phi) / (2 * pi<Real>), theta / pi<Real>};
+        dpdu = 2 * pi<Real> * Vec3<Real>(d.z, 0, -d.x);
+        dpdv = pi<Real> * Vec3<Real>(d.y * std::cos(phi), -radius * std::sin(theta), d.y * std::sin(phi));
     }
 };
 

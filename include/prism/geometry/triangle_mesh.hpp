@@ -9,7 +9,9 @@
 #include <prism/scene/scene.hpp>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <type_traits>
 #include <vector>
 
@@ -102,8 +104,9 @@ public:
     }
 
     // Object-space normals and texture coordinates at a hit.
-    void surface(const Hit<Real>& hit, Vec3<Real>& geometric_normal, Vec3<Real>& shading_normal,
-                 Vec2<Real>& uv) const {
+    // Normals, texture coordinates and the (u, v) tangent frame at a hit, in object space.
+    void surface(const Hit<Real>& hit, Vec3<Real>& geometric_normal, Vec3<Real>& shading_normal, Vec2<Real>& uv,
+                 Vec3<Real>& dpdu, Vec3<Real>& dpdv) const {
         const auto& p = triangles_[hit.primitive];
         geometric_normal = glm::normalize(Vec3<Real>(glm::cross(p[1] - p[0], p[2] - p[0])));
         const Real b0 = Real(1) - hit.b1 - hit.b2;
@@ -115,7 +118,17 @@ public:
             const Real length = glm::length(n);
             if (length > 0) shading_normal = n / length;
         }
-        if (!uvs_.empty()) uv = b0 * uvs_[face[0]] + hit.b1 * uvs_[face[1]] + hit.b2 * uvs_[face[2]];
+        if (uvs_.empty()) return;
+        const Vec2<Real> uv0 = uvs_[face[0]], uv1 = uvs_[face[1]], uv2 = uvs_[face[2]];
+        uv = b0 * uv0 + hit.b1 * uv1 + hit.b2 * uv2;
+        // Solve [e1 e2] = [dpdu dpdv] [duv1 duv2] for the tangents (pbrt-v4 6.5.3); a
+        // degenerate (u, v) mapping leaves them zero and the textures then keep the normal.
+        const Vec2<Real> duv1 = uv1 - uv0, duv2 = uv2 - uv0;
+        const Real determinant = duv1.x * duv2.y - duv1.y * duv2.x;
+        if (std::abs(determinant) < std::numeric_limits<Real>::min()) return;
+        const Vec3<Real> e1 = Vec3<Real>(p[1] - p[0]), e2 = Vec3<Real>(p[2] - p[0]);
+        dpdu = (duv2.y * e1 - duv1.y * e2) / determinant;
+        dpdv = (duv1.x * e2 - duv2.x * e1) / determinant;
     }
 
 private:
