@@ -163,7 +163,7 @@ scene::Scene floor_scene() {
 
 TEST_CASE_TEMPLATE("Renderer: a directional light lights the floor at any distance; shadow rays reach infinity", Real,
                    float, double) {
-    using Punctual = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::PunctualLightSet>;
+    using Punctual = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::AllLightSet>;
     scene::Scene world = floor_scene();
     world.directional_lights.push_back({"sun", {0, -1, -1}, {100, 100, 100}});  // 45 degrees
     const prism::Ray<Real> down{prism::Vec3<Real>(0, 5, 0), prism::Vec3<Real>(0, -1, 0)};
@@ -179,7 +179,7 @@ TEST_CASE_TEMPLATE("Renderer: a directional light lights the floor at any distan
 }
 
 TEST_CASE_TEMPLATE("Renderer: a spot light on the floor follows the cone", Real, float, double) {
-    using Punctual = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::PunctualLightSet>;
+    using Punctual = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::AllLightSet>;
     scene::Scene world = floor_scene();
     scene::SpotLight spot = downward_spot();
     spot.position = {0, 2, 0};

@@ -1,11 +1,12 @@
 // What the example programs share on their command lines: a usage error is one line on stderr
 // and exit status 2, numbers parse whole or not at all, and every program that renders takes the
-// same --threads, --precision and --scale with the same checks.
+// same --threads, --precision, --scale, --ray-offset and --seed with the same checks.
 #pragma once
 
 #include <prism/render/render_scene.hpp>
 
 #include <charconv>
+#include <cstdint>
 #include <cstdlib>
 #include <iostream>
 #include <string>
@@ -47,6 +48,13 @@ public:
         } else if (option == "--scale") {
             options.resolution_scale = number<double>(option, next_value());
             if (!(options.resolution_scale > 0 && options.resolution_scale <= 1)) usage_error("--scale must be in (0, 1]");
+        } else if (option == "--ray-offset") {
+            const std::string_view mode = next_value();
+            if (mode == "error-bound") options.ray_offset = RayOffset::error_bound;
+            else if (mode == "scene-epsilon") options.ray_offset = RayOffset::scene_epsilon;
+            else usage_error("--ray-offset must be error-bound or scene-epsilon");
+        } else if (option == "--seed") {
+            options.seed = number<std::uint64_t>(option, next_value());
         } else {
             return false;
         }

@@ -19,6 +19,9 @@ public:
         const glm::dvec3 m = camera.position - w * camera.near_distance;
         const glm::dvec3 q = m + camera.near_left * u + camera.near_top * v;
         origin_ = Vec3<Real>(camera.position);
+        u_ = Vec3<Real>(u);
+        v_ = Vec3<Real>(v);
+        forward_ = Vec3<Real>(-w);
         top_left_ = Vec3<Real>(q - camera.position);
         step_u_ = Vec3<Real>(u * ((camera.near_right - camera.near_left) / width));
         step_v_ = Vec3<Real>(-v * ((camera.near_top - camera.near_bottom) / height));
@@ -33,9 +36,17 @@ public:
         return {origin_, glm::normalize(top_left_ + x * step_u_ + y * step_v_), Real(0), infinity<Real>};
     }
 
+    // The camera's frame: position, the image plane's right (u) and up (v) axes, and the unit
+    // gaze. A thin lens (camera/thin_lens_camera.hpp) spreads its aperture along u and v.
+    const Vec3<Real>& position() const { return origin_; }
+    const Vec3<Real>& right() const { return u_; }
+    const Vec3<Real>& up() const { return v_; }
+    const Vec3<Real>& forward() const { return forward_; }
+
 private:
     int width_, height_;
     Vec3<Real> origin_, top_left_, step_u_, step_v_;
+    Vec3<Real> u_{1, 0, 0}, v_{0, 1, 0}, forward_{0, 0, -1};
 };
 
 }  // namespace prism

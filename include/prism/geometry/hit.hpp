@@ -32,6 +32,12 @@ struct SurfacePoint {
     Vec3<Real> local_position{0};  // in the object's own space: where solid textures are evaluated
     std::uint32_t material = 0;
     std::span<const std::uint32_t> textures;  // the object's textures (indices into Scene::textures)
+    // What SceneGeometry::spawn_origin needs to leave the surface by its error bound: the hit
+    // point in object space with its error, the object-space geometric normal, the object, and
+    // the instant of the ray that found it.
+    Vec3<Real> object_point{0}, object_error{0}, object_normal{0, 0, 1};
+    std::uint32_t object = 0;
+    Real time = 0;
 };
 
 }  // namespace prism

@@ -13,6 +13,9 @@ struct Ray {
     Vec3<Real> direction{0, 0, -1};
     Real t_min = 0;
     Real t_max = infinity<Real>;
+    // The instant in the shutter interval [0, 1] the ray samples; moving objects (MotionBlur)
+    // are intersected where they are at that instant.
+    Real time = 0;
 
     Vec3<Real> at(Real t) const { return origin + t * direction; }
 };

@@ -2,11 +2,17 @@
 // spheres and planes, placed by instances under a top-level index. This is the two-level
 // hierarchy: a MeshInstance costs one instance record, never a copy of its mesh or its BVH.
 // It satisfies Accelerator: intersect (closest hit) and occluded (any hit).
+// With MotionBlur, an object with a MotionBlur translation m is at M p + m t at shutter instant
+// t: rays are moved back by m t before entering its object space, and its world box covers the
+// whole sweep (the boxes at t = 0 and t = 1 together, exact for a translation).
+// spawn_origin gives leaving rays their origin from the hit point's floating-point error bound
+// (geometry/surface_error.hpp) instead of a scene-tuned epsilon.
 #pragma once
 
 #include <prism/accel/accelerator.hpp>
 #include <prism/geometry/hit.hpp>
 #include <prism/geometry/sphere.hpp>
+#include <prism/geometry/surface_error.hpp>
 #include <prism/geometry/triangle_mesh.hpp>
 #include <prism/scene/scene.hpp>
 
@@ -17,6 +23,19 @@ namespace prism {
 
 template <Scalar Real>
 struct PlaneShape {
+    // The hit point reprojected onto the plane, p - n ((p - q) . n), with a bound on its error
+    // along each axis. Planes are not in pbrt's set, so the bound is derived here: the exact
+    // reprojection of the computed p lies on the plane whatever p's own error; computing it
+    // rounds p - q and the dot product (gamma(4) of sum |n_i| (|p_i| + |q_i|)) and the final
+    // subtraction (u |p'| and u |n d|). gamma(6) (|p| + |p'| + |q|) + gamma(2) |d| covers them
+    // per axis, and d . |n| of it bounds the distance to the plane.
+    PointWithError<Real> hit_point(const Vec3<Real>& approximate) const {
+        const Real d = glm::dot(approximate - point, normal);
+        const Vec3<Real> projected = approximate - normal * d;
+        return {projected, gamma<Real>(6) * (glm::abs(approximate) + glm::abs(projected) + glm::abs(point)) +
+                               Vec3<Real>(gamma<Real>(2) * std::abs(d))};
+    }
+
     Vec3<Real> point{0};
     Vec3<Real> normal{0, 1, 0};  // unit
 
@@ -30,7 +49,7 @@ struct PlaneShape {
     }
 };
 
-template <Scalar Real, class Policy>
+template <Scalar Real, class Policy, bool MotionBlur = false>
     requires AccelerationPolicy<Policy, Real>
 class SceneGeometry {
 public:
@@ -41,15 +60,15 @@ public:
         for (const auto& mesh : scene.meshes) {
             meshes_.emplace_back(mesh);
             add_instance(Kind::mesh, std::uint32_t(meshes_.size() - 1), mesh.material, mesh.transform,
-                         meshes_.back().bounds(), mesh.textures);
+                         meshes_.back().bounds(), mesh.textures, mesh.motion);
         }
         for (const auto& instance : scene.mesh_instances)
             add_instance(Kind::mesh, std::uint32_t(instance.base_mesh), instance.material, instance.transform,
-                         meshes_[instance.base_mesh].bounds(), instance.textures);
+                         meshes_[instance.base_mesh].bounds(), instance.textures, instance.motion);
         for (const auto& sphere : scene.spheres) {
             spheres_.push_back({Vec3<Real>(sphere.center), Real(sphere.radius)});
             add_instance(Kind::sphere, std::uint32_t(spheres_.size() - 1), sphere.material, sphere.transform,
-                         spheres_.back().bounds(), sphere.textures);
+                         spheres_.back().bounds(), sphere.textures, sphere.motion);
         }
         // Planes are unbounded, so they stay outside the top-level index and are tested always.
         for (const auto& plane : scene.planes) {
@@ -126,9 +145,14 @@ public:
     SurfacePoint<Real> surface(const Ray<Real>& ray, const Hit<Real>& hit) const {
         SurfacePoint<Real> point;
         point.position = ray.at(hit.t);
+        point.object = hit.object;
+        point.time = ray.time;
         if (hit.object >= instances_.size()) {
             const std::size_t p = hit.object - instances_.size();
-            point.geometric_normal = point.shading_normal = planes_[p].normal;
+            point.geometric_normal = point.shading_normal = point.object_normal = planes_[p].normal;
+            const PointWithError<Real> exact = planes_[p].hit_point(point.position);
+            point.object_point = exact.point;
+            point.object_error = exact.error;
             point.local_position = point.position;
             point.material = plane_materials_[p];
             point.textures = texture_lists_[plane_textures_[p]];
@@ -137,15 +161,23 @@ public:
         const Instance& instance = instances_[hit.object];
         point.material = instance.material;
         point.textures = texture_lists_[instance.textures];
-        point.local_position = instance.transformed ? instance.to_object(point.position) : point.position;
+        const Vec3<Real> unmoved = point.position - displacement(instance, ray.time);
+        point.local_position = instance.transformed ? instance.to_object(unmoved) : unmoved;
         Vec3<Real> geometric_normal, shading_normal;
+        PointWithError<Real> exact;
         if (instance.kind == Kind::mesh) {
-            meshes_[instance.shape].surface(hit, geometric_normal, shading_normal, point.uv, point.dpdu, point.dpdv);
+            const auto& mesh = meshes_[instance.shape];
+            mesh.surface(hit, geometric_normal, shading_normal, point.uv, point.dpdu, point.dpdv);
+            exact = mesh.spawn_point(hit);
         } else {
             const SphereShape<Real>& sphere = spheres_[instance.shape];
             geometric_normal = shading_normal = glm::normalize(point.local_position - sphere.center);
             sphere.parametrise(point.local_position, point.uv, point.dpdu, point.dpdv);
+            exact = sphere_hit_point(sphere.center, sphere.radius, point.local_position);
         }
+        point.object_point = exact.point;
+        point.object_error = exact.error;
+        point.object_normal = geometric_normal;
         if (instance.transformed) {
             geometric_normal = glm::normalize(instance.normal_to_world * geometric_normal);
             shading_normal = glm::normalize(instance.normal_to_world * shading_normal);
@@ -156,6 +188,29 @@ public:
         point.geometric_normal = geometric_normal;
         point.shading_normal = shading_normal;
         return point;
+    }
+
+    // The origin of a ray leaving `point` (from surface()) towards `direction`: the exact hit
+    // point pushed past its error bound along the geometric normal, to the side the ray leaves
+    // by, so the ray cannot find the surface it left again, at any scale and in float or double.
+    Vec3<Real> spawn_origin(const SurfacePoint<Real>& point, const Vec3<Real>& direction) const {
+        const PointWithError<Real> exact{point.object_point, point.object_error};
+        if (point.object >= instances_.size()) return offset_ray_origin(exact, point.object_normal, direction);
+        const Instance& instance = instances_[point.object];
+        Vec3<Real> origin = instance.transformed
+                                ? offset_ray_origin(transforms_[instance.transform], exact, point.object_normal, direction)
+                                : offset_ray_origin(exact, point.object_normal, direction);
+        if constexpr (MotionBlur) {
+            if (instance.moving) {
+                // Moving the origin by m t rounds once more, by at most u (|origin| + |m t|) per
+                // axis: clear that along the world normal too.
+                const Vec3<Real> shift = instance.motion * point.time;
+                origin += shift;
+                origin = offset_ray_origin(origin, gamma<Real>(2) * (glm::abs(origin) + glm::abs(shift)),
+                                           point.geometric_normal, direction);
+            }
+        }
+        return origin;
     }
 
 private:
@@ -170,18 +225,22 @@ private:
         Mat3<Real> world_to_object_linear{1};
         Mat3<Real> normal_to_world{1};
         Mat3<Real> object_to_world_linear{1};
-        std::uint32_t textures = 0;  // index into texture_lists_
+        std::uint32_t textures = 0;   // index into texture_lists_
+        std::uint32_t transform = 0;  // index into transforms_, when transformed
+        bool moving = false;
+        Vec3<Real> motion{0};
         Aabb<Real> world_bounds;
 
         Vec3<Real> to_object(const Vec3<Real>& p) const { return Vec3<Real>(world_to_object * Vec4<Real>(p, 1)); }
         // The direction is transformed but not renormalised, so t means the same in both spaces.
         Ray<Real> to_object(const Ray<Real>& ray) const {
-            return {to_object(ray.origin), world_to_object_linear * ray.direction, ray.t_min, ray.t_max};
+            return {to_object(ray.origin), world_to_object_linear * ray.direction, ray.t_min, ray.t_max, ray.time};
         }
     };
 
     void add_instance(Kind kind, std::uint32_t shape, std::size_t material, const glm::dmat4& transform,
-                      const Aabb<Real>& object_bounds, const std::vector<std::size_t>& textures) {
+                      const Aabb<Real>& object_bounds, const std::vector<std::size_t>& textures,
+                      const glm::dvec3& motion) {
         Instance instance;
         instance.textures = add_texture_list(textures);
         instance.kind = kind;
@@ -195,11 +254,25 @@ private:
             instance.world_to_object_linear = Mat3<Real>(glm::dmat3(inverse));
             instance.normal_to_world = Mat3<Real>(glm::transpose(glm::dmat3(inverse)));
             instance.object_to_world_linear = Mat3<Real>(glm::dmat3(transform));
+            instance.transform = std::uint32_t(transforms_.size());
+            transforms_.emplace_back(transform);
             for (int c = 0; c < 8; ++c)
                 instance.world_bounds.extend(
                     Vec3<Real>(transform * glm::dvec4(glm::dvec3(object_bounds.corner(c)), 1.0)));
         } else {
             instance.world_bounds = object_bounds;
+        }
+        if (MotionBlur && motion != glm::dvec3(0.0)) {
+            instance.moving = true;
+            instance.motion = Vec3<Real>(motion);
+            Aabb<Real> swept = instance.world_bounds;
+            swept.extend(Aabb<Real>{swept.min + instance.motion, swept.max + instance.motion});
+            // The sweep's corners are rounded sums: one ulp outwards keeps the box conservative.
+            for (int axis = 0; axis < 3; ++axis) {
+                swept.min[axis] = next_down(swept.min[axis]);
+                swept.max[axis] = next_up(swept.max[axis]);
+            }
+            instance.world_bounds = swept;
         }
         instances_.push_back(instance);
     }
@@ -210,9 +283,29 @@ private:
         return std::uint32_t(texture_lists_.size() - 1);
     }
 
+    // Where a moving instance has gone by the instant `time`; zero without motion blur.
+    Vec3<Real> displacement(const Instance& instance, Real time) const {
+        if constexpr (MotionBlur) {
+            if (instance.moving) return instance.motion * time;
+        }
+        return Vec3<Real>(0);
+    }
+
+    // The ray in the instance's object space, at the ray's instant for moving instances.
+    Ray<Real> to_object(const Instance& instance, const Ray<Real>& ray) const {
+        if constexpr (MotionBlur) {
+            if (instance.moving) {
+                Ray<Real> unmoved = ray;
+                unmoved.origin -= instance.motion * ray.time;
+                return instance.transformed ? instance.to_object(unmoved) : unmoved;
+            }
+        }
+        return instance.transformed ? instance.to_object(ray) : ray;
+    }
+
     template <bool CullBackfaces>
     bool intersect_instance(const Instance& instance, const Ray<Real>& ray, Real& t_max, Hit<Real>& hit) const {
-        const Ray<Real> local = instance.transformed ? instance.to_object(ray) : ray;
+        const Ray<Real> local = to_object(instance, ray);
         if (instance.kind == Kind::mesh) return meshes_[instance.shape].template intersect<CullBackfaces>(local, t_max, hit);
         Real t;
         if (!spheres_[instance.shape].intersect(local, ray.t_min, t_max, t)) return false;
@@ -223,7 +316,7 @@ private:
     }
 
     bool occludes(const Instance& instance, const Ray<Real>& ray, Real t_max) const {
-        const Ray<Real> local = instance.transformed ? instance.to_object(ray) : ray;
+        const Ray<Real> local = to_object(instance, ray);
         if (instance.kind == Kind::mesh) return meshes_[instance.shape].occluded(local, t_max);
         Real t;
         return spheres_[instance.shape].intersect(local, ray.t_min, t_max, t) && t < t_max;
@@ -237,6 +330,7 @@ private:
     // Each object's texture indices; entry 0 is the empty list that untextured objects share.
     std::vector<std::vector<std::uint32_t>> texture_lists_{1};
     std::vector<Instance> instances_;
+    std::vector<InstanceTransforms<Real>> transforms_;
     Index top_;
 };
 

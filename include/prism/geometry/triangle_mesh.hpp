@@ -5,6 +5,7 @@
 
 #include <prism/accel/accelerator.hpp>
 #include <prism/geometry/hit.hpp>
+#include <prism/geometry/surface_error.hpp>
 #include <prism/math/floating_point.hpp>
 #include <prism/scene/scene.hpp>
 
@@ -104,6 +105,14 @@ public:
     }
 
     // Object-space normals and texture coordinates at a hit.
+    // The hit point computed from the barycentrics, with the error bound a leaving ray must
+    // clear (geometry/surface_error.hpp), in object space and the precision the triangle is
+    // stored in.
+    PointWithError<Real> spawn_point(const Hit<Real>& hit) const {
+        const auto& p = triangles_[hit.primitive];
+        return triangle_spawn_point<Real>(p[0], p[1], p[2], hit.b1, hit.b2);
+    }
+
     // Normals, texture coordinates and the (u, v) tangent frame at a hit, in object space.
     void surface(const Hit<Real>& hit, Vec3<Real>& geometric_normal, Vec3<Real>& shading_normal, Vec2<Real>& uv,
                  Vec3<Real>& dpdu, Vec3<Real>& dpdv) const {

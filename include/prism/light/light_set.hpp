@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <tuple>
+#include <type_traits>
 #include <vector>
 
 namespace prism {
@@ -21,6 +22,16 @@ public:
     template <class Visit>
     void for_each(Visit&& visit) const {
         std::apply([&](const auto&... vectors) { (visit_all(vectors, visit), ...); }, lights_);
+    }
+
+    // The lights of one type, or nullptr when the set does not hold that type (so code for a
+    // light type compiles away in sets without it).
+    template <template <class> class Type>
+    const std::vector<Type<Real>>* of_type() const {
+        if constexpr ((std::is_same_v<Type<Real>, LightTypes<Real>> || ...))
+            return &std::get<std::vector<Type<Real>>>(lights_);
+        else
+            return nullptr;
     }
 
     std::size_t size() const {

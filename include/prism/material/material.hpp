@@ -16,12 +16,13 @@ struct Material {
     Real absorption_index = 0;
     Vec3<Real> absorption_coefficient{0};
     Vec3<Real> transparency{0};
+    Real roughness = 0;  // perturbs reflected and refracted directions (render/whitted_integrator.hpp)
 
     explicit Material(const scene::Material& m)
         : type(m.type), ambient(m.ambient), diffuse(m.diffuse), specular(m.specular), mirror(m.mirror),
           phong_exponent(Real(m.phong_exponent)), refraction_index(Real(m.refraction_index)),
           absorption_index(Real(m.absorption_index)), absorption_coefficient(m.absorption_coefficient),
-          transparency(m.transparency) {}
+          transparency(m.transparency), roughness(Real(m.roughness)) {}
 };
 
 }  // namespace prism

@@ -5,6 +5,7 @@
 
 #include <prism/geometry/double_refine.hpp>
 #include <prism/image/image.hpp>
+#include <prism/light/area_light.hpp>
 #include <prism/light/directional_light.hpp>
 #include <prism/light/point_light.hpp>
 #include <prism/light/spot_light.hpp>
@@ -45,6 +46,8 @@ struct RenderOptions {
     std::optional<Precision> precision;   // empty: chosen from the scene
     double resolution_scale = 1.0;        // < 1 renders a reduced image (suite, quick checks)
     bool cull_backfaces = false;          // primary rays skip triangles facing away
+    RayOffset ray_offset = RayOffset::scene_epsilon;
+    std::uint64_t seed = 0;               // the pixels' random streams (multisampling, lights)
 };
 
 struct CameraImage {
@@ -76,21 +79,44 @@ inline Choice choose_precision(const scene::Scene& scene, const RenderOptions& o
     return {Precision::double_all, measured + ", below 2^-16: double throughout"};
 }
 
-// The two light sets a scene can get: point lights alone (every hw1 and hw2 scene), or every
-// punctual light (point, directional, spot: glTF's word for lights that are a point or a
-// direction). Two, not one per combination, to keep the compiled renderers few.
+// The two renderers a scene can get in each precision: the fitted one, with point lights alone
+// and no per-ray features (every hw1 and hw2 scene), or the complete one, with every light type,
+// textures and motion blur. Two, not one per combination, to keep the compiled renderers few
+// (each costs about 20 s of compile time on two cores); bench/ measures what the fitted one
+// saves.
 using PointLightSet = Lights<PointLight>;
-using PunctualLightSet = Lights<PointLight, DirectionalLight, SpotLight>;
+using AllLightSet = Lights<PointLight, DirectionalLight, SpotLight, AreaLight>;
+inline constexpr Features no_features{};
+inline constexpr Features all_features{.textures = true, .motion_blur = true};
 
 // Every light the scene describes, of any type. A light type added to scene::Scene must be
 // counted here, so that a renderer whose light set lacks it refuses the scene instead of
 // leaving the light out.
 inline std::size_t scene_light_count(const scene::Scene& scene) {
-    return scene.point_lights.size() + scene.directional_lights.size() + scene.spot_lights.size();
+    return scene.point_lights.size() + scene.directional_lights.size() + scene.spot_lights.size() +
+           scene.area_lights.size() + scene.environment_lights.size();
 }
 
-inline bool needs_punctual_lights(const scene::Scene& scene) {
-    return !scene.directional_lights.empty() || !scene.spot_lights.empty();
+// Whether the scene needs more than the fitted renderer: other lights than point lights,
+// textures, or moving objects. Returns what it needs, for the log; empty when nothing.
+inline std::string complete_renderer_reason(const scene::Scene& scene) {
+    std::string reason;
+    const auto add = [&](bool needed, const char* what) {
+        if (!needed) return;
+        reason += reason.empty() ? "" : ", ";
+        reason += what;
+    };
+    add(!scene.directional_lights.empty(), "directional lights");
+    add(!scene.spot_lights.empty(), "spot lights");
+    add(!scene.area_lights.empty(), "area lights");
+    add(!scene.environment_lights.empty(), "environment lights");
+    add(!scene.textures.empty(), "textures");
+    const auto moving = [](const auto& objects) {
+        return std::any_of(objects.begin(), objects.end(),
+                           [](const auto& object) { return object.motion != glm::dvec3(0.0); });
+    };
+    add(moving(scene.meshes) || moving(scene.spheres) || moving(scene.mesh_instances), "motion blur");
+    return reason;
 }
 
 // The image size a camera renders at under RenderOptions::resolution_scale (at least 1 pixel).
@@ -116,7 +142,7 @@ std::vector<CameraImage> render_with(const scene::Scene& scene, const RenderOpti
                                     std::to_string(C::LightTypes::count_in(scene)));
     using Clock = std::chrono::steady_clock;
     const auto build_start = Clock::now();
-    const Renderer<C> renderer(scene, options.cull_backfaces);
+    const Renderer<C> renderer(scene, RendererSettings{options.cull_backfaces, options.ray_offset, options.seed});
     const double build_seconds = std::chrono::duration<double>(Clock::now() - build_start).count();
     log << "built " << renderer.geometry().instance_count() << " instances, " << renderer.geometry().triangle_count()
         << " triangles in " << build_seconds << " s\n";
@@ -134,11 +160,11 @@ std::vector<CameraImage> render_with(const scene::Scene& scene, const RenderOpti
 }
 
 template <Scalar Real, class Acceleration>
-std::vector<CameraImage> render_with_lights(const scene::Scene& scene, const RenderOptions& options, std::ostream& log,
-                                            const std::function<void(std::size_t camera, int pixels)>& on_tile) {
-    if (needs_punctual_lights(scene))
-        return render_with<Config<Real, Acceleration, PunctualLightSet>>(scene, options, log, on_tile);
-    return render_with<Config<Real, Acceleration, PointLightSet>>(scene, options, log, on_tile);
+std::vector<CameraImage> render_fitted(const scene::Scene& scene, const RenderOptions& options, std::ostream& log,
+                                       const std::function<void(std::size_t camera, int pixels)>& on_tile) {
+    if (!complete_renderer_reason(scene).empty())
+        return render_with<Config<Real, Acceleration, AllLightSet, all_features>>(scene, options, log, on_tile);
+    return render_with<Config<Real, Acceleration, PointLightSet, no_features>>(scene, options, log, on_tile);
 }
 
 }  // namespace detail
@@ -158,16 +184,20 @@ inline std::vector<CameraImage> render_scene(
     const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
     tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
     const Choice choice = choose_precision(scene, options);
-    log << "configuration: " << describe(choice.precision) << ", "
-        << (needs_punctual_lights(scene) ? "point, directional and spot lights" : "point lights") << " ("
-        << choice.reason << ")\n";
+    const std::string complete = complete_renderer_reason(scene);
+    log << "configuration: " << describe(choice.precision) << " (" << choice.reason << "); "
+        << (complete.empty() ? "point lights only, no textures or motion blur"
+                             : "all light types, textures and motion blur (the scene has " + complete + ")")
+        << "; rays leave surfaces by "
+        << (options.ray_offset == RayOffset::error_bound ? "their error bounds" : "the scene's ShadowRayEpsilon")
+        << '\n';
     switch (choice.precision) {
         case Precision::single:
-            return detail::render_with_lights<float, Bvh<Watertight>>(scene, options, log, on_tile);
+            return detail::render_fitted<float, Bvh<Watertight>>(scene, options, log, on_tile);
         case Precision::double_refine:
-            return detail::render_with_lights<float, Bvh<DoubleRefine>>(scene, options, log, on_tile);
+            return detail::render_fitted<float, Bvh<DoubleRefine>>(scene, options, log, on_tile);
         case Precision::double_all:
-            return detail::render_with_lights<double, Bvh<Watertight>>(scene, options, log, on_tile);
+            return detail::render_fitted<double, Bvh<Watertight>>(scene, options, log, on_tile);
     }
     throw std::logic_error("unknown precision");
 }

@@ -1,9 +1,12 @@
 // The renderer a Config composes: geometry built in the Config's precision with its
-// acceleration policy, its light set, the course's integrator, and tiles of pixels rendered in
-// parallel with TBB into an HDR image.
+// acceleration policy, its light set, textures and motion blur if the Config asks for them, the
+// course's integrator, and tiles of pixels rendered in parallel with TBB into an HDR image.
+// Every pixel draws its samples from its own random stream (sampling/random.hpp), so an image
+// is bit-identical whatever the number of threads.
 #pragma once
 
-#include <prism/camera/pinhole_camera.hpp>
+#include <prism/camera/pixel_sampler.hpp>
+#include <prism/camera/thin_lens_camera.hpp>
 #include <prism/geometry/scene_geometry.hpp>
 #include <prism/image/image.hpp>
 #include <prism/render/config.hpp>
@@ -12,25 +15,40 @@
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace prism {
+
+struct RendererSettings {
+    bool cull_backfaces = false;  // primary rays skip triangles facing away
+    RayOffset ray_offset = RayOffset::scene_epsilon;
+    std::uint64_t seed = 0;       // selects the pixels' random streams
+};
 
 template <class C>
 class Renderer {
 public:
     using Real = typename C::Real;
-    using Geometry = SceneGeometry<Real, typename C::Acceleration>;
+    static constexpr Features features = C::features;
+    using Geometry = SceneGeometry<Real, typename C::Acceleration, features.motion_blur>;
     using LightSetT = typename C::LightTypes::template Set<Real>;
+    using TexturesT = NoTextures<Real>;
+    using EnvironmentT = NoEnvironment<Real>;
+    using Integrator = WhittedIntegrator<Real, Geometry, LightSetT, TexturesT, EnvironmentT>;
 
     static constexpr int tile_size = 16;
 
-    explicit Renderer(const scene::Scene& scene, bool cull_backfaces = false)
-        : geometry_(scene), lights_(scene), materials_(convert_materials(scene)),
-          integrator_(geometry_, lights_, materials_, Vec3<Real>(scene.ambient_light), Vec3<Real>(scene.background_color),
-                      IntegratorSettings{scene.max_recursion_depth, scene.shadow_ray_epsilon, cull_backfaces}) {}
+    explicit Renderer(const scene::Scene& scene, const RendererSettings& settings = {})
+        : geometry_(check_features(scene)), lights_(scene), materials_(convert_materials(scene)), textures_(scene),
+          settings_(settings),
+          integrator_(geometry_, lights_, materials_, textures_, environment_, Vec3<Real>(scene.ambient_light),
+                      Vec3<Real>(scene.background_color),
+                      IntegratorSettings{scene.max_recursion_depth, scene.shadow_ray_epsilon, settings.ray_offset,
+                                         settings.cull_backfaces}) {}
 
     // A renderer holds references into itself (the integrator into geometry and lights).
     Renderer(const Renderer&) = delete;
@@ -45,23 +63,65 @@ public:
     Image render(const scene::Camera& camera, int width = 0, int height = 0, OnTile on_tile = [](int) {}) const {
         if (width <= 0) width = camera.width;
         if (height <= 0) height = camera.height;
-        const PinholeCamera<Real> pinhole(camera, width, height);
+        const ThinLensCamera<Real> lens(camera, width, height);
+        const int count = std::max(1, camera.num_samples);
         Image image(width, height);
         tbb::parallel_for(tbb::blocked_range2d<int>(0, height, tile_size, 0, width, tile_size),
                           [&](const tbb::blocked_range2d<int>& tile) {
+                              std::vector<CameraSample<Real>> samples;
+                              std::vector<Vec2<Real>> scratch;
                               for (int y = tile.rows().begin(); y < tile.rows().end(); ++y)
                                   for (int x = tile.cols().begin(); x < tile.cols().end(); ++x)
-                                      image(x, y) = glm::vec3(integrator_.radiance(
-                                          pinhole.ray(Real(x) + Real(0.5), Real(y) + Real(0.5)), 0));
+                                      image(x, y) = pixel(lens, camera.filter, count, x, y, samples, scratch);
                               on_tile(int(tile.rows().size() * tile.cols().size()));
                           });
         return image;
     }
 
-    // Radiance along one ray (unit direction), for tests and tools.
-    Vec3<Real> radiance(const Ray<Real>& ray) const { return integrator_.radiance(ray, 0); }
+    // Radiance along one ray (unit direction) at shutter instant ray.time, for tests and tools;
+    // lights and roughness are sampled from the stream of pixel (0, 0).
+    Vec3<Real> radiance(const Ray<Real>& ray) const {
+        Random random = Random::for_pixel(0, 0, settings_.seed);
+        return integrator_.radiance(ray, random, Vec2<Real>(Real(0.5)));
+    }
 
 private:
+    glm::vec3 pixel(const ThinLensCamera<Real>& lens, scene::PixelFilter filter, int count, int x, int y,
+                    std::vector<CameraSample<Real>>& samples, std::vector<Vec2<Real>>& scratch) const {
+        Random random = Random::for_pixel(x, y, settings_.seed);
+        camera_samples(count, random, samples, scratch);
+        const Vec2<Real> pixel_uv((Real(x) + Real(0.5)) / Real(lens.width()), (Real(y) + Real(0.5)) / Real(lens.height()));
+        Vec3<Real> sum(0);
+        Real weights = 0;
+        for (const CameraSample<Real>& sample : samples) {
+            const Ray<Real> ray = lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time);
+            const Real weight = filter_weight(filter, sample.pixel);
+            sum += weight * integrator_.radiance(ray, random, pixel_uv);
+            weights += weight;
+        }
+        return glm::vec3(sum / weights);
+    }
+
+    // A renderer compiled without a feature refuses a scene that needs it, rather than
+    // rendering it wrong.
+    static const scene::Scene& check_features(const scene::Scene& scene) {
+        if constexpr (!features.motion_blur) {
+            const auto moving = [](const auto& objects) {
+                for (const auto& object : objects)
+                    if (object.motion != glm::dvec3(0.0)) return true;
+                return false;
+            };
+            if (moving(scene.meshes) || moving(scene.spheres) || moving(scene.mesh_instances))
+                throw std::invalid_argument("the scene has moving objects (MotionBlur), and this renderer was "
+                                            "compiled without motion blur");
+        }
+        if constexpr (!features.textures) {
+            if (!scene.textures.empty())
+                throw std::invalid_argument("the scene has textures, and this renderer was compiled without them");
+        }
+        return scene;
+    }
+
     static std::vector<Material<Real>> convert_materials(const scene::Scene& scene) {
         std::vector<Material<Real>> materials;
         for (const auto& material : scene.materials) materials.emplace_back(material);
@@ -71,7 +131,10 @@ private:
     Geometry geometry_;
     LightSetT lights_;
     std::vector<Material<Real>> materials_;
-    WhittedIntegrator<Real, Geometry, LightSetT> integrator_;
+    TexturesT textures_;
+    EnvironmentT environment_;
+    RendererSettings settings_;
+    Integrator integrator_;
 };
 
 }  // namespace prism

@@ -2,42 +2,97 @@
 // ambient + per-light diffuse and specular with shadow rays; mirror and conductor reflection
 // (conductors weighted by their Fresnel reflectance); dielectric reflection and refraction with
 // Fresnel weights, total internal reflection, and Beer's law attenuation inside the medium.
+// The course's distribution effects ride on the same recursion (Cook, Porter and Carpenter
+// 1984): one light sample per light and camera sample (area and environment lights), and
+// Roughness perturbing each reflected and refracted direction once per camera sample.
 #pragma once
 
 #include <prism/geometry/hit.hpp>
 #include <prism/material/fresnel.hpp>
 #include <prism/material/material.hpp>
+#include <prism/sampling/random.hpp>
 
 #include <cmath>
 #include <vector>
 
 namespace prism {
 
-struct IntegratorSettings {
-    int max_recursion_depth = 0;
-    double shadow_ray_epsilon = 1e-3;  // offset along the normal for every secondary ray
-    bool cull_backfaces = false;       // for primary rays; secondary rays must see back faces
+// How a ray leaving a surface is kept from finding that surface again.
+enum class RayOffset {
+    // From the hit point's floating-point error bound (SceneGeometry::spawn_origin): no
+    // scene-tuned number, right at any scale and in float and double alike.
+    error_bound,
+    // The course's: ShadowRayEpsilon along the shading normal, for every secondary ray.
+    scene_epsilon,
 };
 
-template <Scalar Real, class Geometry, class LightSetT>
+struct IntegratorSettings {
+    int max_recursion_depth = 0;
+    double shadow_ray_epsilon = 1e-3;  // RayOffset::scene_epsilon's offset
+    RayOffset ray_offset = RayOffset::scene_epsilon;
+    bool cull_backfaces = false;  // for primary rays; secondary rays must see back faces
+};
+
+// A surface's textures as the integrator uses them; `NoTextures` is the policy of renderers
+// compiled without texture support, and costs nothing.
+template <Scalar Real>
+struct NoTextures {
+    explicit NoTextures(const scene::Scene&) {}
+    void apply(SurfacePoint<Real>&, Material<Real>&) const {}
+    bool has_background() const { return false; }
+    Vec3<Real> background(const Vec2<Real>&) const { return Vec3<Real>(0); }
+};
+
+// What escaping rays see, for renderers without environment lights: the background colour for
+// primary rays, nothing for the others.
+template <Scalar Real>
+struct NoEnvironment {
+    bool present() const { return false; }
+    Vec3<Real> radiance(const Vec3<Real>&) const { return Vec3<Real>(0); }
+};
+
+// Perturbs a unit direction by the course's glossy model: r' = normalize(r + roughness (a u +
+// b v)) with a, b uniform in [-1/2, 1/2) and (u, v) an orthonormal basis perpendicular to r,
+// built from r with its smallest component set to 1 (the course's construction).
+template <Scalar Real>
+Vec3<Real> perturb(const Vec3<Real>& direction, Real roughness, const Vec2<Real>& sample) {
+    Vec3<Real> helper = direction;
+    const Vec3<Real> magnitude = glm::abs(direction);
+    if (magnitude.x <= magnitude.y && magnitude.x <= magnitude.z) helper.x = 1;
+    else if (magnitude.y <= magnitude.z) helper.y = 1;
+    else helper.z = 1;
+    const Vec3<Real> u = glm::normalize(glm::cross(helper, direction));
+    const Vec3<Real> v = glm::cross(direction, u);
+    return glm::normalize(direction + roughness * ((sample.x - Real(0.5)) * u + (sample.y - Real(0.5)) * v));
+}
+
+template <Scalar Real, class Geometry, class LightSetT, class Textures = NoTextures<Real>,
+          class Environment = NoEnvironment<Real>>
 class WhittedIntegrator {
 public:
     WhittedIntegrator(const Geometry& geometry, const LightSetT& lights, const std::vector<Material<Real>>& materials,
-                      const Vec3<Real>& ambient_light, const Vec3<Real>& background, const IntegratorSettings& settings)
-        : geometry_(geometry), lights_(lights), materials_(materials), ambient_light_(ambient_light),
-          background_(background), settings_(settings), epsilon_(Real(settings.shadow_ray_epsilon)) {}
+                      const Textures& textures, const Environment& environment, const Vec3<Real>& ambient_light,
+                      const Vec3<Real>& background, const IntegratorSettings& settings)
+        : geometry_(geometry), lights_(lights), materials_(materials), textures_(textures), environment_(environment),
+          ambient_light_(ambient_light), background_(background), settings_(settings),
+          epsilon_(Real(settings.shadow_ray_epsilon)) {}
 
-    // Radiance arriving along a ray with a unit direction.
-    Vec3<Real> radiance(Ray<Real> ray, int depth) const {
+    // Radiance arriving along a camera ray with a unit direction. `pixel_uv` is the pixel's
+    // position in [0, 1]^2 from the top left, where a background texture is looked up.
+    Vec3<Real> radiance(const Ray<Real>& ray, Random& random, const Vec2<Real>& pixel_uv) const {
+        return trace(ray, 0, random, pixel_uv);
+    }
+
+private:
+    Vec3<Real> trace(Ray<Real> ray, int depth, Random& random, const Vec2<Real>& pixel_uv) const {
         Hit<Real> hit;
         const bool found = (depth == 0 && settings_.cull_backfaces) ? geometry_.template intersect<true>(ray, hit)
                                                                     : geometry_.template intersect<false>(ray, hit);
-        // The course shows the background only where primary rays escape; a secondary ray
-        // that escapes brings back nothing.
-        if (!found) return depth == 0 ? background_ : Vec3<Real>(0);
+        if (!found) return escaped(ray.direction, depth, pixel_uv);
 
-        const SurfacePoint<Real> point = geometry_.surface(ray, hit);
-        const Material<Real>& material = materials_[point.material];
+        SurfacePoint<Real> point = geometry_.surface(ray, hit);
+        Material<Real> material = materials_[point.material];
+        textures_.apply(point, material);
         const Vec3<Real>& d = ray.direction;
         const bool front_face = glm::dot(point.geometric_normal, d) < 0;
         // Shading uses the normal on the side the ray arrives from.
@@ -50,26 +105,30 @@ public:
         Vec3<Real> color(0);
         if (!inside_medium) {
             color = material.ambient * ambient_light_;
-            color += direct_lighting(point.position, normal, -d, material);
+            color += direct_lighting(point, normal, -d, material, random);
         }
 
         // Blinn-Phong surfaces spawn no rays; the others reflect (and dielectrics refract).
         if (depth < settings_.max_recursion_depth && material.type != scene::MaterialType::blinn_phong) {
             using scene::MaterialType;
             const Real cos_incident = -glm::dot(d, normal);
-            const Vec3<Real> reflected = d + 2 * cos_incident * normal;
-            const Ray<Real> reflection{point.position + normal * epsilon_, reflected};
+            Vec3<Real> reflected = d + 2 * cos_incident * normal;
+            if (material.roughness > 0) reflected = perturb(reflected, material.roughness, random.uniform2<Real>());
+            const Ray<Real> reflection = leaving(point, normal, reflected, ray.time);
             switch (material.type) {
                 case MaterialType::blinn_phong: break;
-                case MaterialType::mirror: color += material.mirror * radiance(reflection, depth + 1); break;
+                case MaterialType::mirror:
+                    color += material.mirror * trace(reflection, depth + 1, random, pixel_uv);
+                    break;
                 case MaterialType::conductor: {
                     const Real fresnel = fresnel_conductor(std::max(cos_incident, Real(0)), material.refraction_index,
                                                            material.absorption_index);
-                    color += fresnel * material.mirror * radiance(reflection, depth + 1);
+                    color += fresnel * material.mirror * trace(reflection, depth + 1, random, pixel_uv);
                     break;
                 }
                 case MaterialType::dielectric:
-                    color += dielectric(point.position, d, normal, cos_incident, front_face, material, reflection, depth);
+                    color += dielectric(point, d, normal, cos_incident, front_face, material, reflection, depth,
+                                        random, pixel_uv);
                     break;
             }
         }
@@ -82,24 +141,44 @@ public:
         return color;
     }
 
-private:
-    Vec3<Real> direct_lighting(const Vec3<Real>& position, const Vec3<Real>& normal, const Vec3<Real>& to_viewer,
-                               const Material<Real>& material) const {
+    // A ray that meets nothing: primary rays show the background (texture, environment or
+    // colour); the course's secondary rays bring back nothing unless an environment surrounds
+    // the scene.
+    Vec3<Real> escaped(const Vec3<Real>& direction, int depth, const Vec2<Real>& pixel_uv) const {
+        if (depth == 0 && textures_.has_background()) return textures_.background(pixel_uv);
+        if (environment_.present()) return environment_.radiance(direction);
+        return depth == 0 ? background_ : Vec3<Real>(0);
+    }
+
+    // The ray leaving `point` along `direction`; `normal` is the shading normal facing the
+    // incoming ray (the scene-epsilon mode offsets along it, to the side the ray leaves by).
+    Ray<Real> leaving(const SurfacePoint<Real>& point, const Vec3<Real>& normal, const Vec3<Real>& direction,
+                      Real time) const {
+        Ray<Real> ray{Vec3<Real>(0), direction, Real(0), infinity<Real>, time};
+        if (settings_.ray_offset == RayOffset::error_bound) {
+            ray.origin = geometry_.spawn_origin(point, direction);
+        } else {
+            ray.origin = point.position + (glm::dot(direction, normal) >= 0 ? normal : -normal) * epsilon_;
+        }
+        return ray;
+    }
+
+    Vec3<Real> direct_lighting(const SurfacePoint<Real>& point, const Vec3<Real>& normal, const Vec3<Real>& to_viewer,
+                               const Material<Real>& material, Random& random) const {
         Vec3<Real> color(0);
-        const Vec3<Real> shadow_origin = position + normal * epsilon_;
+        const Vec3<Real>& position = point.position;
         lights_.for_each([&](const auto& light) {
-            const LightSample<Real> sample = light.sample({position, normal});
+            const LightSample<Real> sample = light.sample({position, normal}, random.uniform2<Real>());
             const Real cos_light = glm::dot(normal, sample.direction);
             if (cos_light <= 0) return;
             // The shadow ray leaves the offset origin aimed at the light, and anything nearer than
             // the light's distance from the shading point blocks it. So a surface through the
             // light itself blocks it for every point, not by rounding (mirror_room's ceiling
             // holds a light: 20.3 dB with a per-pixel coin flip, 64.5 dB consistent).
-            const Vec3<Real> shadow_direction =
-                std::isinf(sample.distance)
-                    ? sample.direction
-                    : glm::normalize(position + sample.direction * sample.distance - shadow_origin);
-            const Ray<Real> shadow{shadow_origin, shadow_direction, Real(0), sample.distance};
+            Ray<Real> shadow = leaving(point, normal, sample.direction, point.time);
+            if (!std::isinf(sample.distance))
+                shadow.direction = glm::normalize(position + sample.direction * sample.distance - shadow.origin);
+            shadow.t_max = sample.distance;
             if (geometry_.occluded(shadow)) return;
             const Vec3<Real> half_vector = glm::normalize(sample.direction + to_viewer);
             const Real cos_half = std::max(glm::dot(normal, half_vector), Real(0));
@@ -109,27 +188,30 @@ private:
         return color;
     }
 
-    Vec3<Real> dielectric(const Vec3<Real>& position, const Vec3<Real>& d, const Vec3<Real>& normal, Real cos_incident,
-                          bool front_face, const Material<Real>& material, const Ray<Real>& reflection,
-                          int depth) const {
+    Vec3<Real> dielectric(const SurfacePoint<Real>& point, const Vec3<Real>& d, const Vec3<Real>& normal,
+                          Real cos_incident, bool front_face, const Material<Real>& material,
+                          const Ray<Real>& reflection, int depth, Random& random, const Vec2<Real>& pixel_uv) const {
         const Real n1 = front_face ? Real(1) : material.refraction_index;
         const Real n2 = front_face ? material.refraction_index : Real(1);
         const Real ratio = n1 / n2;
         const Real sin2_transmitted = ratio * ratio * (1 - cos_incident * cos_incident);
-        if (sin2_transmitted >= 1) return radiance(reflection, depth + 1);  // total internal reflection
+        if (sin2_transmitted >= 1) return trace(reflection, depth + 1, random, pixel_uv);  // total internal reflection
         const Real cos_transmitted = std::sqrt(1 - sin2_transmitted);
         const Real fresnel = fresnel_dielectric(cos_incident, cos_transmitted, n1, n2);
-        const Vec3<Real> transmitted = glm::normalize(ratio * d + (ratio * cos_incident - cos_transmitted) * normal);
-        const Ray<Real> refraction{position - normal * epsilon_, transmitted};
-        Vec3<Real> through = (1 - fresnel) * radiance(refraction, depth + 1);
+        Vec3<Real> transmitted = glm::normalize(ratio * d + (ratio * cos_incident - cos_transmitted) * normal);
+        if (material.roughness > 0) transmitted = perturb(transmitted, material.roughness, random.uniform2<Real>());
+        const Ray<Real> refraction = leaving(point, normal, transmitted, reflection.time);
+        Vec3<Real> through = (1 - fresnel) * trace(refraction, depth + 1, random, pixel_uv);
         // Pre-2020 scenes describe glass by a Transparency colour that filters what passes.
         if (material.transparency != Vec3<Real>(0)) through *= material.transparency;
-        return fresnel * radiance(reflection, depth + 1) + through;
+        return fresnel * trace(reflection, depth + 1, random, pixel_uv) + through;
     }
 
     const Geometry& geometry_;
     const LightSetT& lights_;
     const std::vector<Material<Real>>& materials_;
+    const Textures& textures_;
+    const Environment& environment_;
     Vec3<Real> ambient_light_;
     Vec3<Real> background_;
     IntegratorSettings settings_;

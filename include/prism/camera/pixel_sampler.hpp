@@ -1,0 +1,90 @@
+// Where a pixel's camera samples go: NumSamples points of the pixel, of the lens and of the
+// shutter interval, each set stratified on its own and the sets shuffled against each other, so
+// that no dimension repeats another's pattern (Shirley 1991; pbrt-v4's StratifiedSampler and its
+// independent padding of dimensions). A square count gets a jittered k x k grid; any other count
+// gets n-rooks (one sample per row and per column of an n x n grid), which stratifies both axes.
+// The reconstruction filter weighs each sample by its position in the pixel.
+#pragma once
+
+#include <prism/sampling/random.hpp>
+#include <prism/scene/scene.hpp>
+
+#include <cmath>
+#include <utility>
+#include <vector>
+
+namespace prism {
+
+template <Scalar Real>
+struct CameraSample {
+    Vec2<Real> pixel{0.5};  // position inside the pixel, [0, 1)^2 from its top-left corner
+    Vec2<Real> lens{0.5};   // point of the aperture, [0, 1)^2
+    Real time = 0;          // shutter instant, [0, 1)
+};
+
+namespace detail {
+
+template <class T>
+void shuffle(std::vector<T>& values, Random& random) {
+    for (std::size_t i = values.size(); i > 1; --i) std::swap(values[i - 1], values[random.below(std::uint32_t(i))]);
+}
+
+// n stratified points of [0, 1)^2: jittered grid for square n, n-rooks otherwise.
+template <Scalar Real>
+void stratified_2d(int n, Random& random, std::vector<Vec2<Real>>& points) {
+    points.resize(std::size_t(n));
+    const int side = int(std::lround(std::sqrt(double(n))));
+    if (side * side == n) {
+        for (int j = 0; j < side; ++j)
+            for (int i = 0; i < side; ++i) {
+                const Vec2<Real> jitter = random.uniform2<Real>();
+                points[std::size_t(j * side + i)] = (Vec2<Real>(Real(i), Real(j)) + jitter) / Real(side);
+            }
+        return;
+    }
+    std::vector<int> columns(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) columns[std::size_t(i)] = i;
+    shuffle(columns, random);
+    for (int i = 0; i < n; ++i) {
+        const Vec2<Real> jitter = random.uniform2<Real>();
+        points[std::size_t(i)] = (Vec2<Real>(Real(i), Real(columns[std::size_t(i)])) + jitter) / Real(n);
+    }
+}
+
+}  // namespace detail
+
+// Fills `samples` with the pixel's `count` camera samples from its random stream. `scratch`
+// avoids reallocating per pixel.
+template <Scalar Real>
+void camera_samples(int count, Random& random, std::vector<CameraSample<Real>>& samples,
+                    std::vector<Vec2<Real>>& scratch) {
+    samples.resize(std::size_t(count));
+    if (count == 1) {
+        // One sample: the pixel centre, as the course's single-sample images are rendered; lens
+        // and time still vary between pixels.
+        samples[0] = {Vec2<Real>(Real(0.5)), random.uniform2<Real>(), random.uniform<Real>()};
+        return;
+    }
+    detail::stratified_2d(count, random, scratch);
+    for (int i = 0; i < count; ++i) samples[std::size_t(i)].pixel = scratch[std::size_t(i)];
+    detail::stratified_2d(count, random, scratch);
+    detail::shuffle(scratch, random);
+    for (int i = 0; i < count; ++i) samples[std::size_t(i)].lens = scratch[std::size_t(i)];
+    // Time: one jittered stratum per sample, shuffled.
+    for (int i = 0; i < count; ++i) scratch[std::size_t(i)].x = (Real(i) + random.uniform<Real>()) / Real(count);
+    for (std::size_t i = std::size_t(count); i > 1; --i) std::swap(scratch[i - 1].x, scratch[random.below(std::uint32_t(i))].x);
+    for (int i = 0; i < count; ++i) samples[std::size_t(i)].time = scratch[std::size_t(i)].x;
+}
+
+// The reconstruction filter's weight of a sample at `pixel` (position in the pixel, [0, 1)^2).
+// Gaussian: standard deviation half a pixel around the centre, so a corner sample weighs e^-1
+// of a central one; each pixel averages its own samples only.
+template <Scalar Real>
+Real filter_weight(scene::PixelFilter filter, const Vec2<Real>& pixel) {
+    if (filter == scene::PixelFilter::box) return Real(1);
+    const Vec2<Real> d = pixel - Vec2<Real>(Real(0.5));
+    constexpr Real sigma = Real(0.5);
+    return std::exp(-glm::dot(d, d) / (2 * sigma * sigma));
+}
+
+}  // namespace prism
