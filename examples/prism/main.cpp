@@ -36,9 +36,10 @@ options:
   --precision P        float | double-refine | double: override the precision chosen from the
                        scene (the choice and its reason are printed)
   --scale S            render at S times the cameras' resolution (0 < S <= 1; quick previews)
-  --ray-offset M       how rays leave surfaces: scene-epsilon (default: the scene's
-                       ShadowRayEpsilon along the normal, as the course renders) or error-bound
-                       (past the hit point's floating-point error bound: no tuned number)
+  --ray-offset M       how rays leave surfaces: scene-epsilon (the scene's ShadowRayEpsilon
+                       along the normal, as the course renders) or error-bound (past the hit
+                       point's floating-point error bound: no tuned number). Default: the
+                       epsilon, unless it is below 64 ulps of the scene's largest coordinate
   --seed N             selects the pixels' random streams (default 0); any thread count gives
                        the same image for the same seed
   --cull-backfaces     primary rays ignore triangles facing away from the camera

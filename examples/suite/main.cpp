@@ -64,7 +64,8 @@ options:
   --threads N          worker threads (default: all hardware threads)
   --precision P        float | double-refine | double: override the precision chosen from
                        the scene
-  --ray-offset M       scene-epsilon (default) | error-bound: how rays leave surfaces
+  --ray-offset M       scene-epsilon | error-bound: how rays leave surfaces (default: as
+                       prism chooses from the scene)
   --seed N             selects the pixels' random streams (default 0)
   --verbose            print the renderer's log (configuration, build times) on stderr
   --help               this text

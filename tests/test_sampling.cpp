@@ -1,0 +1,268 @@
+// The course's distribution ray tracing, for float and double: the per-pixel random streams,
+// stratified camera samples, the reconstruction filter, the thin lens, area lights, motion blur
+// (moving boxes and rays at an instant), roughness, and images bit-identical at 1 and 2 threads.
+#include <prism/camera/pixel_sampler.hpp>
+#include <prism/camera/thin_lens_camera.hpp>
+#include <prism/light/area_light.hpp>
+#include <prism/render/render_scene.hpp>
+#include <prism/render/renderer.hpp>
+#include <prism/sampling/random.hpp>
+
+#include <doctest/doctest.h>
+
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <set>
+#include <sstream>
+#include <vector>
+
+namespace {
+
+namespace scene = prism::scene;
+
+scene::Camera looking_down_z(int width, int height) {
+    scene::Camera camera;
+    camera.position = {0, 0, 10};
+    camera.gaze = {0, 0, -1};
+    camera.up = {0, 1, 0};
+    camera.near_left = camera.near_bottom = -1;
+    camera.near_right = camera.near_top = 1;
+    camera.near_distance = 2;
+    camera.width = width;
+    camera.height = height;
+    return camera;
+}
+
+scene::Material matte(double albedo) {
+    scene::Material material;
+    material.diffuse = glm::dvec3(albedo);
+    return material;
+}
+
+}  // namespace
+
+TEST_CASE_TEMPLATE("Random: reproducible per pixel, uniform in [0, 1), streams differ", Real, float, double) {
+    prism::Random a = prism::Random::for_pixel(3, 7, 42), b = prism::Random::for_pixel(3, 7, 42);
+    prism::Random other_pixel = prism::Random::for_pixel(4, 7, 42), other_seed = prism::Random::for_pixel(3, 7, 43);
+    int same_as_other_pixel = 0, same_as_other_seed = 0;
+    double sum = 0;
+    constexpr int count = 100000;
+    for (int i = 0; i < count; ++i) {
+        const Real u = a.uniform<Real>();
+        REQUIRE(u == b.uniform<Real>());
+        REQUIRE(u >= Real(0));
+        REQUIRE(u < Real(1));
+        same_as_other_pixel += u == other_pixel.uniform<Real>();
+        same_as_other_seed += u == other_seed.uniform<Real>();
+        sum += double(u);
+    }
+    CHECK(same_as_other_pixel < 10);
+    CHECK(same_as_other_seed < 10);
+    // Mean of 10^5 uniforms: standard deviation 1/sqrt(12 * 10^5) = 0.0009.
+    CHECK(sum / count == doctest::Approx(0.5).epsilon(0.01));
+}
+
+TEST_CASE_TEMPLATE("camera_samples: a jittered grid for square counts, n-rooks otherwise", Real, float, double) {
+    prism::Random random = prism::Random::for_pixel(0, 0, 1);
+    std::vector<prism::CameraSample<Real>> samples;
+    std::vector<prism::Vec2<Real>> scratch;
+    SUBCASE("16 samples: one in each cell of a 4 x 4 grid, for the pixel and the lens; one per time stratum") {
+        prism::camera_samples(16, random, samples, scratch);
+        REQUIRE(samples.size() == 16);
+        std::set<int> pixel_cells, lens_cells, time_strata;
+        for (const auto& sample : samples) {
+            pixel_cells.insert(int(sample.pixel.x * 4) + 4 * int(sample.pixel.y * 4));
+            lens_cells.insert(int(sample.lens.x * 4) + 4 * int(sample.lens.y * 4));
+            time_strata.insert(int(sample.time * 16));
+        }
+        CHECK(pixel_cells.size() == 16);
+        CHECK(lens_cells.size() == 16);
+        CHECK(time_strata.size() == 16);
+    }
+    SUBCASE("6 samples: each row and each column of a 6 x 6 grid once") {
+        prism::camera_samples(6, random, samples, scratch);
+        std::set<int> rows, columns;
+        for (const auto& sample : samples) {
+            columns.insert(int(sample.pixel.x * 6));
+            rows.insert(int(sample.pixel.y * 6));
+        }
+        CHECK(rows.size() == 6);
+        CHECK(columns.size() == 6);
+    }
+    SUBCASE("one sample: the pixel centre") {
+        prism::camera_samples(1, random, samples, scratch);
+        CHECK(samples[0].pixel == prism::Vec2<Real>(Real(0.5)));
+    }
+}
+
+TEST_CASE_TEMPLATE("filter_weight: box is flat, the Gaussian has sigma 1/2 pixel", Real, float, double) {
+    using prism::Vec2;
+    CHECK(prism::filter_weight(scene::PixelFilter::box, Vec2<Real>(Real(0.1), Real(0.9))) == Real(1));
+    CHECK(prism::filter_weight(scene::PixelFilter::gaussian, Vec2<Real>(Real(0.5))) == Real(1));
+    // At the corner: d^2 = 1/2, exp(-(1/2) / (2 * 1/4)) = e^-1.
+    CHECK(double(prism::filter_weight(scene::PixelFilter::gaussian, Vec2<Real>(Real(0)))) ==
+          doctest::Approx(std::exp(-1.0)).epsilon(1e-6));
+}
+
+TEST_CASE_TEMPLATE("ThinLensCamera: every lens ray meets the pinhole ray on the plane of focus", Real, float, double) {
+    scene::Camera camera = looking_down_z(8, 8);
+    camera.aperture_size = 0.5;
+    camera.focus_distance = 6;
+    const prism::ThinLensCamera<Real> lens(camera, 8, 8);
+    const prism::PinholeCamera<Real> pinhole(camera, 8, 8);
+    for (const prism::Vec2<Real> image : {prism::Vec2<Real>(Real(4), Real(4)), prism::Vec2<Real>(Real(0.5), Real(7.5))}) {
+        const prism::Ray<Real> centre = pinhole.ray(image.x, image.y);
+        // The plane of focus is z = 10 - 6 = 4 (the gaze is -z).
+        const prism::Vec3<Real> focus = centre.at((Real(10) - Real(4)) / -centre.direction.z);
+        for (const prism::Vec2<Real> at : {prism::Vec2<Real>(Real(0), Real(0)), prism::Vec2<Real>(Real(0.99), Real(0.3))}) {
+            const prism::Ray<Real> ray = lens.ray(image.x, image.y, at, Real(0.25));
+            CHECK(ray.time == Real(0.25));
+            CHECK(double(glm::length(ray.direction)) == doctest::Approx(1).epsilon(1e-6));
+            // The origin lies on the aperture square, within ApertureSize / 2 of the centre.
+            CHECK(double(ray.origin.z) == doctest::Approx(10));
+            CHECK(std::abs(double(ray.origin.x)) <= 0.25 + 1e-6);
+            const prism::Vec3<Real> reached = ray.at((Real(10) - Real(4)) / -ray.direction.z);
+            for (int axis = 0; axis < 3; ++axis)
+                CHECK(double(reached[axis]) == doctest::Approx(double(focus[axis])).epsilon(1e-5).scale(1));
+        }
+    }
+    // No aperture: the pinhole ray itself.
+    camera.aperture_size = 0;
+    const prism::ThinLensCamera<Real> pinhole_lens(camera, 8, 8);
+    const prism::Ray<Real> ray = pinhole_lens.ray(Real(2.5), Real(3.5), prism::Vec2<Real>(Real(0.9)), Real(0));
+    CHECK(ray.origin == pinhole.ray(Real(2.5), Real(3.5)).origin);
+    CHECK(ray.direction == pinhole.ray(Real(2.5), Real(3.5)).direction);
+}
+
+TEST_CASE_TEMPLATE("AreaLight: the estimate averages to the irradiance of the square, from both sides", Real, float,
+                   double) {
+    scene::Scene world;
+    // A 2 x 2 square at height 3 facing up (away from the point), centred above the origin.
+    world.area_lights.push_back({"panel", {-1, 3, -1}, {2, 0, 0}, {0, 0, 2}, {10, 10, 10}});
+    const auto lights = prism::AreaLight<Real>::from_scene(world);
+    REQUIRE(lights.size() == 1);
+    CHECK(double(lights[0].area) == doctest::Approx(4));
+    // Irradiance-like quantity the course integrates: L * integral over the square of
+    // cos_light / d^2 dA, computed here by a fine midpoint rule in double.
+    double expected = 0;
+    constexpr int n = 400;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            const double x = -1 + 2 * (i + 0.5) / n, z = -1 + 2 * (j + 0.5) / n;
+            const double d2 = x * x + 9 + z * z;
+            expected += 10 * (3 / std::sqrt(d2)) / d2 * (4.0 / (n * n));
+        }
+    prism::Random random(7);
+    double sum = 0;
+    constexpr int samples = 200000;
+    for (int s = 0; s < samples; ++s) {
+        const auto sample = lights[0].sample({prism::Vec3<Real>(0), prism::Vec3<Real>(0, 1, 0)}, random.uniform2<Real>());
+        sum += double(sample.radiance.r);
+    }
+    CHECK(sum / samples == doctest::Approx(expected).epsilon(0.005));
+}
+
+TEST_CASE_TEMPLATE("Motion blur: the box covers the sweep, rays meet the object where it is at their instant", Real,
+                   float, double) {
+    scene::Scene world;
+    world.materials.push_back(matte(0.5));
+    scene::Sphere sphere{"moving", 0, {0, 0, 0}, 1, glm::dmat4(1.0)};
+    sphere.motion = {10, 0, 0};
+    world.spheres.push_back(sphere);
+    const prism::SceneGeometry<Real, prism::Bvh<prism::Watertight>, true> geometry(world);
+    const prism::Aabb<Real> box = geometry.bounds();
+    CHECK(double(box.min.x) <= -1);
+    CHECK(double(box.max.x) >= 11);
+    for (double time : {0.0, 0.5, 1.0}) {
+        CAPTURE(time);
+        const double x = 10 * time;
+        prism::Ray<Real> at_object{prism::Vec3<Real>(Real(x), 0, 5), prism::Vec3<Real>(0, 0, -1), Real(0),
+                                   prism::infinity<Real>, Real(time)};
+        prism::Hit<Real> hit;
+        REQUIRE(geometry.intersect(at_object, hit));
+        CHECK(double(hit.t) == doctest::Approx(4));
+        // The surface point's object-space position is where the unmoved sphere was hit.
+        const prism::SurfacePoint<Real> point = geometry.surface(at_object, hit);
+        CHECK(double(point.local_position.z) == doctest::Approx(1));
+        CHECK(double(point.local_position.x) == doctest::Approx(0).scale(1e-5));
+        // Where the sphere was at another instant, the ray passes through empty space.
+        prism::Ray<Real> elsewhere = at_object;
+        elsewhere.time = Real(time < 0.5 ? 1.0 : 0.0);
+        CHECK_FALSE(geometry.occluded(elsewhere));
+    }
+}
+
+TEST_CASE_TEMPLATE("perturb: zero roughness keeps the direction, roughness tilts it within the course's square", Real,
+                   float, double) {
+    const prism::Vec3<Real> mirror = glm::normalize(prism::Vec3<Real>(1, 2, -0.5));
+    const prism::Vec3<Real> same = prism::perturb(mirror, Real(0), prism::Vec2<Real>(Real(0.9), Real(0.1)));
+    for (int axis = 0; axis < 3; ++axis) CHECK(double(same[axis]) == doctest::Approx(double(mirror[axis])));
+    prism::Random random(3);
+    double largest = 0;
+    for (int i = 0; i < 1000; ++i) {
+        const prism::Vec3<Real> tilted = prism::perturb(mirror, Real(0.2), random.uniform2<Real>());
+        CHECK(double(glm::length(tilted)) == doctest::Approx(1).epsilon(1e-6));
+        largest = std::max(largest, std::acos(std::min(1.0, double(glm::dot(tilted, mirror)))));
+    }
+    // The offset a u + b v has length at most 0.2 * sqrt(2) / 2: tan of the angle is at most it.
+    CHECK(largest <= std::atan(0.2 * std::sqrt(0.5)) + 1e-4);
+    CHECK(largest > 0.05);
+}
+
+TEST_CASE_TEMPLATE("Renderer: multisampled, lens, area-lit, glossy and moving images are identical at 1 and 2 threads",
+                   Real, float, double) {
+    scene::Scene world;
+    scene::Camera camera = looking_down_z(24, 16);
+    camera.num_samples = 9;
+    camera.aperture_size = 0.2;
+    camera.focus_distance = 8;
+    camera.filter = scene::PixelFilter::gaussian;
+    world.cameras.push_back(camera);
+    world.materials.push_back(matte(0.7));
+    scene::Material glossy;
+    glossy.type = scene::MaterialType::mirror;
+    glossy.mirror = {0.8, 0.8, 0.8};
+    glossy.diffuse = {0.1, 0.1, 0.1};
+    glossy.roughness = 0.3;
+    world.materials.push_back(glossy);
+    world.planes.push_back({"floor", 0, {0, -1, 0}, {0, 1, 0}, glm::dmat4(1.0)});
+    scene::Sphere ball{"ball", 1, {0, 0, 0}, 1, glm::dmat4(1.0)};
+    ball.motion = {0.5, 0, 0};
+    world.spheres.push_back(ball);
+    world.area_lights.push_back({"panel", {-1, 4, -1}, {2, 0, 0}, {0, 0, 2}, {20, 20, 20}});
+    using Complete = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::AllLightSet, prism::all_features>;
+    const prism::Renderer<Complete> renderer(world);
+    const auto render_with_threads = [&](std::size_t threads) {
+        tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, threads);
+        return renderer.render(world.cameras[0]);
+    };
+    const prism::Image one = render_with_threads(1);
+    const prism::Image two = render_with_threads(2);
+    REQUIRE(one.pixels.size() == two.pixels.size());
+    CHECK(one.pixels == two.pixels);
+    // And the image is not black: the area light does light the scene.
+    float brightest = 0;
+    for (const auto& pixel : one.pixels) brightest = std::max(brightest, pixel.r);
+    CHECK(brightest > 0.1f);
+    // Another seed gives another image (the streams are really used).
+    const prism::Renderer<Complete> reseeded(world, prism::RendererSettings{false, prism::RayOffset::scene_epsilon, 99});
+    CHECK(reseeded.render(world.cameras[0]).pixels != one.pixels);
+}
+
+TEST_CASE("render_scene: a fitted renderer refuses what it was compiled without") {
+    scene::Scene world;
+    world.cameras.push_back(looking_down_z(2, 2));
+    world.materials.push_back(matte(0.5));
+    scene::Sphere ball{"ball", 0, {0, 0, 0}, 1, glm::dmat4(1.0)};
+    ball.motion = {1, 0, 0};
+    world.spheres.push_back(ball);
+    using Fitted = prism::Config<float, prism::Bvh<prism::Watertight>, prism::PointLightSet>;
+    const auto build_fitted = [&] { const prism::Renderer<Fitted> fitted(world); };
+    CHECK_THROWS_WITH_AS(build_fitted(), doctest::Contains("MotionBlur"), std::invalid_argument);
+    // render_scene picks the complete renderer for it, and says why.
+    std::ostringstream log;
+    const auto images = prism::render_scene(world, prism::RenderOptions{}, log);
+    CHECK(images.size() == 1);
+    CHECK(log.str().find("motion blur") != std::string::npos);
+}
