@@ -194,6 +194,10 @@ TEST_CASE("the images a camera writes") {
     CHECK(outputs[2].name == fs::path("out/cube_aces.png"));
     CHECK(outputs[2].tonemap == 1u);
     CHECK(outputs[3].name == fs::path("out/cube_filmic.png"));
+    // An Extension that is only a file type replaces the .exr: not "cube.png.png".
+    Tonemap plain;
+    plain.extension = ".png";
+    CHECK(prism::tone_mapped_image_name("out/cube.exr", plain) == fs::path("out/cube.png"));
 
     // A .png image name with Tonemaps is itself tone-mapped: by the one without Extension...
     camera.image_name = "cube.png";

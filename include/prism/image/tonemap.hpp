@@ -168,7 +168,8 @@ inline std::filesystem::path tone_mapped_image_name(const std::string& image_nam
     const std::filesystem::path name(image_name);
     if (settings.extension.empty()) return is_exr_name(name) ? std::filesystem::path(name).replace_extension(".png") : name;
     std::string file = name.stem().string() + settings.extension;
-    if (std::filesystem::path(settings.extension).extension().empty()) file += ".png";
+    // "x" + : an Extension that is only ".png" is a file extension, not a hidden file's name.
+    if (std::filesystem::path("x" + settings.extension).extension().empty()) file += ".png";
     return name.parent_path() / file;
 }
 
