@@ -1,6 +1,6 @@
 // What the example programs share on their command lines: a usage error is one line on stderr
 // and exit status 2, numbers parse whole or not at all, and every program that renders takes the
-// same --threads, --precision, --scale, --ray-offset and --seed with the same checks.
+// same --threads, --precision, --scale, --max-samples, --ray-offset and --seed with the same checks.
 #pragma once
 
 #include <prism/render/render_scene.hpp>
@@ -48,6 +48,9 @@ public:
         } else if (option == "--scale") {
             options.resolution_scale = number<double>(option, next_value());
             if (!(options.resolution_scale > 0 && options.resolution_scale <= 1)) usage_error("--scale must be in (0, 1]");
+        } else if (option == "--max-samples") {
+            options.max_samples = number<int>(option, next_value());
+            if (options.max_samples < 1) usage_error("--max-samples must be at least 1");
         } else if (option == "--ray-offset") {
             const std::string_view mode = next_value();
             if (mode == "error-bound") options.ray_offset = RayOffset::error_bound;

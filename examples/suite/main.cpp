@@ -56,6 +56,7 @@ options:
   --format xml|json    only scene files of this format
   --scale S            render at S times the cameras' resolution (0 < S <= 1); the reference
                        is box-filtered down to the render's size before comparing
+  --max-samples N      at most N samples per pixel, whatever NumSamples says
   --threshold DB       PSNR a judged image must reach to pass (default 40)
   --require LEVEL      high | medium | any: the least reference confidence that is judged
                        (default high); images with weaker references are listed as `info`

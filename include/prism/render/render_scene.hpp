@@ -45,6 +45,7 @@ struct RenderOptions {
     int threads = 0;                      // 0: all hardware threads
     std::optional<Precision> precision;   // empty: chosen from the scene
     double resolution_scale = 1.0;        // < 1 renders a reduced image (suite, quick checks)
+    int max_samples = 0;                  // > 0 caps every camera's NumSamples (quick checks)
     bool cull_backfaces = false;          // primary rays skip triangles facing away
     std::optional<RayOffset> ray_offset;  // empty: chosen from the scene (choose_ray_offset)
     std::uint64_t seed = 0;               // the pixels' random streams (multisampling, lights)
@@ -172,7 +173,8 @@ std::vector<CameraImage> render_with(const scene::Scene& scene, const RenderOpti
         << " triangles in " << build_seconds << " s\n";
     std::vector<CameraImage> images;
     for (std::size_t c = 0; c < scene.cameras.size(); ++c) {
-        const scene::Camera& camera = scene.cameras[c];
+        scene::Camera camera = scene.cameras[c];
+        if (options.max_samples > 0) camera.num_samples = std::min(camera.num_samples, options.max_samples);
         const int width = scaled_size(camera.width, options.resolution_scale);
         const int height = scaled_size(camera.height, options.resolution_scale);
         const auto start = Clock::now();
