@@ -9,14 +9,25 @@
 //     resetTransform="true") and their material (their own, else the base's).
 //   - SpotLight angles are full apex angles in degrees; DirectionalLight's Direction is the way the
 //     light travels. A camera's Tonemaps must name distinct images.
+//   - Textures, images and the background texture: texture_loader.hpp (both schemas; an older
+//     schema's bumpmap="true" texture becomes its DecalMode texture plus a bump_normal one).
+//   - AreaLight: the 2019+ square (centre, Normal, Size) becomes corner + two edges, the course's
+//     orthonormal pair around the normal (read_area_light); the 2017-2018 corner + EdgeVectors
+//     form is taken as written, its Intensity as the radiance.
+//   - MotionBlur on Mesh, Triangle, Sphere and MeshInstance (the instance's own, else none);
+//     an instance's textures are its own, else its base mesh's.
+//   - degamma="true" materials get Ambient/Diffuse/SpecularReflectance linearised by pow(c, 2.2).
+//   - A camera's <Filter>box|gaussian</Filter> is prism's own extension (default box).
 //   - Elements of later topics are skipped and named once each in Scene::unsupported.
 #pragma once
 
 #include <prism/image/tonemap.hpp>
 #include <prism/io/binary_data.hpp>
 #include <prism/io/element.hpp>
+#include <prism/io/element_reader.hpp>
 #include <prism/io/load_error.hpp>
 #include <prism/io/ply.hpp>
+#include <prism/io/texture_loader.hpp>
 #include <prism/math/transform.hpp>
 #include <prism/scene/scene.hpp>
 
@@ -45,38 +56,10 @@ namespace prism::io {
 
 namespace detail::scene_loader {
 
-inline std::vector<std::string_view> split_words(std::string_view text) {
-    std::vector<std::string_view> words;
-    std::size_t i = 0;
-    while (i < text.size()) {
-        while (i < text.size() && Element::is_blank(text[i])) ++i;
-        const std::size_t start = i;
-        while (i < text.size() && !Element::is_blank(text[i])) ++i;
-        if (i > start) words.push_back(text.substr(start, i - start));
-    }
-    return words;
-}
 
-inline std::string_view trim(std::string_view text) {
-    while (!text.empty() && Element::is_blank(text.front())) text.remove_prefix(1);
-    while (!text.empty() && Element::is_blank(text.back())) text.remove_suffix(1);
-    return text;
-}
-
-// Appended piece by piece: `"\"" + std::string(text)` draws GCC 12's false -Wrestrict warning
-// (GCC bug 105651) wherever the optimiser inlines it.
-inline std::string in_quotes(std::string_view text) {
-    std::string quoted;
-    quoted.reserve(text.size() + 2);
-    quoted += '"';
-    quoted += text;
-    quoted += '"';
-    return quoted;
-}
-
-class Interpreter {
+class Interpreter : private ElementReader {
 public:
-    explicit Interpreter(const std::filesystem::path& file) : file_(file), folder_(file.parent_path()) {}
+    explicit Interpreter(const std::filesystem::path& file) : ElementReader(file) {}
 
     scene::Scene interpret(const Element& root) {
         if (root.name != "Scene") fail(root, "the root element must be <Scene>, not <" + root.name + ">");
@@ -89,6 +72,7 @@ public:
             else if (child.name == "TexCoordData") read_texture_coordinates(child);
             else if (child.name == "Transformations") read_transformations(child);
             else if (child.name == "Materials") read_materials(child);
+            else if (child.name == "Textures") textures_.read(child);
         }
         for (const Element& child : root.children) {
             const std::string& name = child.name;
@@ -100,140 +84,15 @@ public:
             else if (name == "Cameras") read_cameras(child);
             else if (name == "Lights") read_lights(child);
             else if (name == "Objects") read_objects(child);
-            else if (name != "VertexData" && name != "TexCoordData" && name != "Transformations" && name != "Materials")
+            else if (name != "VertexData" && name != "TexCoordData" && name != "Transformations" && name != "Materials" &&
+                     name != "Textures")
                 note_unsupported(child);
         }
+        scene_.unsupported = take_unsupported();
         return std::move(scene_);
     }
 
 private:
-    // ---- faults -----------------------------------------------------------------------------
-
-    [[noreturn]] void fail(const Element& element, const std::string& message) const {
-        throw LoadError(file_, element.where(), message);
-    }
-
-    const Element& required(const Element& parent, std::string_view name) const {
-        const Element* child = parent.child(name);
-        if (child == nullptr) fail(parent, "missing <" + std::string(name) + ">");
-        return *child;
-    }
-
-    const std::string& required_attribute(const Element& element, std::string_view name) const {
-        const std::string* value = element.attribute(name);
-        if (value == nullptr) fail(element, "missing attribute " + std::string(name));
-        return *value;
-    }
-
-    void check_single(const Element& parent, std::initializer_list<std::string_view> names) const {
-        for (std::string_view name : names) {
-            const auto count = std::count_if(parent.children.begin(), parent.children.end(),
-                                             [&](const Element& c) { return c.name == name; });
-            if (count > 1) fail(parent, "<" + std::string(name) + "> is given " + std::to_string(count) + " times");
-        }
-    }
-
-    // Later topics' elements are skipped, but named, so the renderer can say what it leaves out.
-    void note_unsupported(const Element& element) {
-        if (element.is_empty()) return;  // `<Textures></Textures>` asks for nothing
-        if (unsupported_seen_.insert(element.name).second) scene_.unsupported.push_back(element.name);
-    }
-
-    void note_unsupported_children(const Element& parent, std::initializer_list<std::string_view> known) {
-        for (const Element& child : parent.children)
-            if (std::find(known.begin(), known.end(), child.name) == known.end()) note_unsupported(child);
-    }
-
-    // ---- values -----------------------------------------------------------------------------
-
-    double parse_number(const Element& element, std::string_view word) const {
-        std::string_view digits = word;
-        if (digits.size() > 1 && digits.front() == '+') digits.remove_prefix(1);  // from_chars refuses '+'
-        double value = 0.0;
-        const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
-        if (error == std::errc::result_out_of_range) fail(element, in_quotes(word) + " is out of the range of a double");
-        if (error != std::errc() || end != digits.data() + digits.size())
-            fail(element, in_quotes(word) + " is not a number");
-        if (!std::isfinite(value)) fail(element, in_quotes(word) + " is not a finite number");
-        return value;
-    }
-
-    std::vector<double> numbers(const Element& element) const {
-        std::vector<double> values;
-        for (std::string_view word : split_words(element.text)) values.push_back(parse_number(element, word));
-        return values;
-    }
-
-    std::vector<double> numbers(const Element& element, std::size_t count) const {
-        std::vector<double> values = numbers(element);
-        if (values.size() != count)
-            fail(element, "expected " + std::to_string(count) + (count == 1 ? " number" : " numbers") + ", found " +
-                              std::to_string(values.size()));
-        return values;
-    }
-
-    double number(const Element& element) const { return numbers(element, 1)[0]; }
-
-    double non_negative(const Element& element) const {
-        const double value = number(element);
-        if (value < 0.0) fail(element, "must not be negative");
-        return value;
-    }
-
-    scene::Vec3 vector3(const Element& element) const {
-        const std::vector<double> v = numbers(element, 3);
-        return {v[0], v[1], v[2]};
-    }
-
-    // Integers may be written as such or as an integral number ("800", "8e2").
-    long long parse_integer(const Element& element, std::string_view word) const {
-        long long value = 0;
-        const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), value);
-        if (error == std::errc() && end == word.data() + word.size()) return value;
-        const double real = parse_number(element, word);
-        if (real != std::floor(real) || std::abs(real) > 9.0e15) fail(element, in_quotes(word) + " is not an integer");
-        return static_cast<long long>(real);
-    }
-
-    std::vector<long long> integers(const Element& element) const {
-        std::vector<long long> values;
-        for (std::string_view word : split_words(element.text)) values.push_back(parse_integer(element, word));
-        return values;
-    }
-
-    long long integer(const Element& element) const {
-        const std::vector<std::string_view> words = split_words(element.text);
-        if (words.size() != 1) fail(element, "expected 1 integer, found " + std::to_string(words.size()) + " values");
-        return parse_integer(element, words[0]);
-    }
-
-    long long integer_at_least(const Element& element, long long minimum) const {
-        const long long value = integer(element);
-        if (value < minimum) fail(element, "must be at least " + std::to_string(minimum) + ", not " + std::to_string(value));
-        return value;
-    }
-
-    long long integer_attribute(const Element& element, std::string_view name, long long fallback) const {
-        const std::string* value = element.attribute(name);
-        if (value == nullptr) return fallback;
-        const std::string_view word = trim(*value);
-        long long result = 0;
-        const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), result);
-        if (error != std::errc() || end != word.data() + word.size() || word.empty())
-            fail(element, "attribute " + std::string(name) + "=" + in_quotes(*value) + " is not an integer");
-        return result;
-    }
-
-    bool boolean_attribute(const Element& element, std::string_view name, bool fallback) const {
-        const std::string* value = element.attribute(name);
-        if (value == nullptr) return fallback;
-        const std::string_view word = trim(*value);
-        if (word == "true") return true;
-        if (word == "false") return false;
-        fail(element, "attribute " + std::string(name) + "=" + in_quotes(*value) + " must be \"true\" or \"false\"");
-    }
-
-    std::string text_of(const Element& element) const { return std::string(trim(element.text)); }
 
     // ---- definitions ------------------------------------------------------------------------
 
@@ -305,10 +164,6 @@ private:
         }
     }
 
-    std::string required_id(const Element& element) const {
-        return std::string(trim(required_attribute(element, "id")));
-    }
-
     // `<Transformations>s1 t2 r1</Transformations>`: applied in the order written.
     glm::dmat4 transformation_of(const Element& object) const {
         glm::dmat4 matrix(1.0);
@@ -350,6 +205,7 @@ private:
             if (const Element* e = element.child("Transparency")) material.transparency = vector3(*e);
             if (const Element* e = element.child("Roughness")) material.roughness = non_negative(*e);
             material.degamma = boolean_attribute(element, "degamma", false);
+            if (material.degamma) linearise_reflectances(element, material);
 
             const std::string* type = element.attribute("type");
             const std::string_view type_name = type != nullptr ? trim(*type) : std::string_view();
@@ -375,6 +231,16 @@ private:
             if (!material_indices_.emplace(material.id, scene_.materials.size()).second)
                 fail(element, "a <Material> with this id is already defined");
             scene_.materials.push_back(std::move(material));
+        }
+    }
+
+    // degamma="true": the reflectances are sRGB-encoded colours (cube_point_hdr.xml: "Read these
+    // values by applying degamma transform"); the course linearises them with pow(c, 2.2).
+    void linearise_reflectances(const Element& element, scene::Material& material) const {
+        for (scene::Vec3* colour : {&material.ambient, &material.diffuse, &material.specular}) {
+            if (glm::any(glm::lessThan(*colour, scene::Vec3(0.0))))
+                fail(element, "degamma needs non-negative reflectances");
+            *colour = glm::pow(*colour, scene::Vec3(2.2));
         }
     }
 
@@ -473,6 +339,12 @@ private:
         if (const Element* e = element.child("NumSamples")) camera.num_samples = int(integer_at_least(*e, 1));
         if (const Element* e = element.child("ApertureSize")) camera.aperture_size = non_negative(*e);
         if (const Element* e = element.child("FocusDistance")) camera.focus_distance = non_negative(*e);
+        // <Filter>box|gaussian</Filter>: prism's own extension, not a course element; box (equal
+        // weights) is what the course's multisampling does.
+        if (const Element* e = element.child("Filter")) {
+            using enum scene::PixelFilter;
+            camera.filter = keyword<scene::PixelFilter>(*e, "pixel filter", {{"box", box}, {"gaussian", gaussian}});
+        }
 
         if (const std::string* handedness = element.attribute("handedness")) {
             const std::string_view hand = trim(*handedness);
@@ -493,7 +365,7 @@ private:
 
         note_unsupported_children(element, {"Position", "Gaze", "GazePoint", "Up", "NearPlane", "NearDistance", "FovY",
                                             "ImageResolution", "ImageName", "NumSamples", "ApertureSize",
-                                            "FocusDistance", "Transformations", "Tonemap"});
+                                            "FocusDistance", "Filter", "Transformations", "Tonemap"});
         scene_.cameras.push_back(std::move(camera));
     }
 
@@ -570,6 +442,10 @@ private:
                 scene_.directional_lights.push_back(std::move(light));
             } else if (element.name == "SpotLight") {
                 scene_.spot_lights.push_back(read_spot_light(element));
+            } else if (element.name == "AreaLight") {
+                scene_.area_lights.push_back(read_area_light(element));
+            } else if (element.name == "SphericalDirectionalLight") {
+                scene_.environment_lights.push_back(read_environment_light(element));
             } else {
                 note_unsupported(element);
             }
@@ -600,7 +476,85 @@ private:
         return light;
     }
 
+    // Two forms. 2019+: Position is the centre of a square of side Size facing Normal, Radiance
+    // its radiance; the square's edges are the course's orthonormal pair for a direction n (the
+    // one its glossy reflections use): u = normalize(h x n), with h = n whose smallest-magnitude
+    // component is set to 1, and v = n x u; so edge1 x edge2 points along Normal, and a normal
+    // along an axis gives axis-aligned edges (0 -1 0: edge1 along -z, edge2 along +x).
+    // 2017-2018: Position is a corner, EdgeVector1 and EdgeVector2 the edges, Intensity the
+    // radiance (scene.hpp). Transformations, if any, move the corner and the edges.
+    scene::AreaLight read_area_light(const Element& element) {
+        scene::AreaLight light;
+        light.id = id_of(element);
+        const scene::Vec3 position = vector3(required(element, "Position"));
+        if (element.child("EdgeVector1") != nullptr || element.child("EdgeVector2") != nullptr) {
+            light.corner = position;
+            light.edge1 = vector3(required(element, "EdgeVector1"));
+            light.edge2 = vector3(required(element, "EdgeVector2"));
+        } else {
+            const Element& normal_element = required(element, "Normal");
+            const scene::Vec3 normal = vector3(normal_element);
+            if (glm::length(normal) == 0.0) fail(normal_element, "the normal is zero");
+            const double size = positive(required(element, "Size"));
+            const scene::Vec3 n = glm::normalize(normal);
+            scene::Vec3 helper = n;
+            const scene::Vec3 magnitude = glm::abs(n);
+            if (magnitude.x <= magnitude.y && magnitude.x <= magnitude.z) helper.x = 1.0;
+            else if (magnitude.y <= magnitude.z) helper.y = 1.0;
+            else helper.z = 1.0;
+            const scene::Vec3 u = glm::normalize(glm::cross(helper, n));
+            const scene::Vec3 v = glm::cross(n, u);
+            light.edge1 = size * u;
+            light.edge2 = size * v;
+            light.corner = position - 0.5 * (light.edge1 + light.edge2);
+        }
+        const Element* radiance = element.child("Radiance");
+        light.radiance = vector3(radiance != nullptr ? *radiance : required(element, "Intensity"));
+        const glm::dmat4 transform = transformation_of(element);
+        light.corner = transform_point(transform, light.corner);
+        light.edge1 = transform_direction(transform, light.edge1);
+        light.edge2 = transform_direction(transform, light.edge2);
+        if (glm::length(glm::cross(light.edge1, light.edge2)) == 0.0) fail(element, "the light's edges span no area");
+        note_unsupported_children(element, {"Position", "Normal", "Size", "Radiance", "EdgeVector1", "EdgeVector2",
+                                            "Intensity", "Transformations"});
+        return light;
+    }
+
+    // <SphericalDirectionalLight type="latlong|probe"><ImageId/><Sampler/>: an image of
+    // <Textures><Images> around the scene; Sampler uniform|cosine (default, as the course) or
+    // importance; Scale (1 or 3 numbers) multiplies the image's radiance.
+    scene::EnvironmentLight read_environment_light(const Element& element) {
+        scene::EnvironmentLight light;
+        light.id = id_of(element);
+        light.image = textures_.image_of(required(element, "ImageId"));
+        if (const std::string* type = element.attribute("type")) {
+            using enum scene::EnvironmentLayout;
+            light.layout = keyword<scene::EnvironmentLayout>(element, "environment layout", *type,
+                                                             {{"latlong", latlong}, {"probe", probe}});
+        }
+        if (const Element* e = element.child("Sampler")) {
+            using enum scene::EnvironmentSampling;
+            light.sampling = keyword<scene::EnvironmentSampling>(
+                *e, "sampler", {{"uniform", uniform}, {"cosine", cosine}, {"importance", importance}});
+        }
+        if (const Element* e = element.child("Scale")) {
+            const std::vector<double> v = numbers(*e);
+            if (v.size() == 1) light.scale = scene::Vec3(v[0]);
+            else if (v.size() == 3) light.scale = {v[0], v[1], v[2]};
+            else fail(*e, "expected 1 or 3 numbers, found " + std::to_string(v.size()));
+            if (glm::any(glm::lessThan(light.scale, scene::Vec3(0.0)))) fail(*e, "must not be negative");
+        }
+        note_unsupported_children(element, {"ImageId", "Sampler", "Scale"});
+        return light;
+    }
+
     // ---- objects ----------------------------------------------------------------------------
+
+    // <MotionBlur>x y z</MotionBlur>: the world-space translation over the shutter interval.
+    scene::Vec3 motion_of(const Element& object) const {
+        const Element* motion = object.child("MotionBlur");
+        return motion != nullptr ? vector3(*motion) : scene::Vec3(0.0);
+    }
 
     // A 1-based index into VertexData, as Sphere's Center and Plane's Point give it.
     scene::Vec3 vertex_of(const Element& reference) const {
@@ -616,11 +570,6 @@ private:
         if (mode == nullptr || trim(*mode) == "flat") return scene::ShadingMode::flat;
         if (trim(*mode) == "smooth") return scene::ShadingMode::smooth;
         fail(element, "shadingMode must be \"flat\" or \"smooth\", not " + in_quotes(*mode));
-    }
-
-    std::string id_of(const Element& element) const {
-        const std::string* id = element.attribute("id");
-        return id != nullptr ? std::string(trim(*id)) : std::string();
     }
 
     // Builds one mesh's own vertex list from global indices: each global vertex (with its
@@ -718,7 +667,9 @@ private:
         }
         if (!has_faces) fail(element, "missing <Faces>");
         finish_mesh(mesh);
-        note_unsupported_children(element, {"Material", "Transformations", "Faces"});
+        mesh.textures = textures_.textures_of(element);
+        mesh.motion = motion_of(element);
+        note_unsupported_children(element, {"Material", "Transformations", "Faces", "Textures", "Texture", "MotionBlur"});
         if (!mesh_indices_.emplace(mesh.id, scene_.meshes.size()).second) ambiguous_mesh_ids_.insert(mesh.id);
         scene_.meshes.push_back(std::move(mesh));
     }
@@ -736,7 +687,9 @@ private:
         MeshBuilder builder{mesh};
         add_indexed_faces(builder, indices, corners, 0, 0);
         finish_mesh(mesh);
-        note_unsupported_children(element, {"Material", "Transformations", "Indices"});
+        mesh.textures = textures_.textures_of(element);
+        mesh.motion = motion_of(element);
+        note_unsupported_children(element, {"Material", "Transformations", "Indices", "Textures", "Texture", "MotionBlur"});
         scene_.meshes.push_back(std::move(mesh));
     }
 
@@ -754,7 +707,10 @@ private:
         const Element& radius = required(element, "Radius");
         sphere.radius = number(radius);
         if (!(sphere.radius > 0.0)) fail(radius, "the radius must be positive");
-        note_unsupported_children(element, {"Material", "Transformations", "Center", "Radius"});
+        sphere.textures = textures_.textures_of(element);
+        sphere.motion = motion_of(element);
+        note_unsupported_children(element,
+                                  {"Material", "Transformations", "Center", "Radius", "Textures", "Texture", "MotionBlur"});
         scene_.spheres.push_back(std::move(sphere));
     }
 
@@ -767,7 +723,8 @@ private:
         const Element& normal = required(element, "Normal");
         plane.normal = vector3(normal);
         if (glm::length(plane.normal) == 0.0) fail(normal, "the normal is zero");
-        note_unsupported_children(element, {"Material", "Transformations", "Point", "Normal"});
+        plane.textures = textures_.textures_of(element);
+        note_unsupported_children(element, {"Material", "Transformations", "Point", "Normal", "Textures", "Texture"});
         scene_.planes.push_back(std::move(plane));
     }
 
@@ -806,12 +763,14 @@ private:
             const std::string base_id(trim(required_attribute(element, "baseMeshId")));
             glm::dmat4 base_transform(1.0);
             std::size_t base_material = 0;
+            std::vector<std::size_t> base_textures;
             if (const auto mesh = mesh_indices_.find(base_id); mesh != mesh_indices_.end()) {
                 if (ambiguous_mesh_ids_.count(base_id) != 0)
                     fail(element, "baseMeshId " + in_quotes(base_id) + " is ambiguous: several meshes have this id");
                 instance.base_mesh = mesh->second;
                 base_transform = scene_.meshes[mesh->second].transform;
                 base_material = scene_.meshes[mesh->second].material;
+                base_textures = scene_.meshes[mesh->second].textures;
             } else if (const auto other = instance_indices.find(base_id); other != instance_indices.end()) {
                 if (ambiguous_instance_ids.count(base_id) != 0)
                     fail(element, "baseMeshId " + in_quotes(base_id) + " is ambiguous: several instances have this id");
@@ -819,6 +778,7 @@ private:
                 instance.base_mesh = instances[other->second].base_mesh;
                 base_transform = instances[other->second].transform;
                 base_material = instances[other->second].material;
+                base_textures = instances[other->second].textures;
             } else {
                 fail(element, "unknown baseMeshId " + in_quotes(base_id) + ": no <Mesh> has this id");
             }
@@ -826,23 +786,27 @@ private:
             instance.transform = boolean_attribute(element, "resetTransform", false) ? own : own * base_transform;
             const Element* material = element.child("Material");
             instance.material = material != nullptr ? material_of(*material) : base_material;
-            note_unsupported_children(element, {"Material", "Transformations"});
+            // Textures follow the material: the instance's own, else its base's. Motion is the
+            // instance's own only (no course file moves an instance; a base mesh's MotionBlur
+            // moves that mesh, not its copies).
+            const bool own_textures = element.child("Textures") != nullptr || element.child("Texture") != nullptr;
+            instance.textures = own_textures ? textures_.textures_of(element) : base_textures;
+            instance.motion = motion_of(element);
+            note_unsupported_children(element, {"Material", "Transformations", "Textures", "Texture", "MotionBlur"});
             state[i] = State::done;
         };
         for (std::size_t i = 0; i < elements.size(); ++i) resolve(resolve, i);
         for (scene::MeshInstance& instance : instances) scene_.mesh_instances.push_back(std::move(instance));
     }
 
-    std::filesystem::path file_;
-    std::filesystem::path folder_;  // PLY files are named relative to the scene file
     scene::Scene scene_;
+    TextureLoader textures_{*this, scene_};
     std::vector<scene::Vec3> vertices_;
     std::vector<scene::Vec2> texture_coordinates_;
     std::map<std::string, glm::dmat4> transformations_;  // key: kind letter and id, as referenced ("t1")
     std::map<std::string, std::size_t> material_indices_;
     std::map<std::string, std::size_t> mesh_indices_;     // ids of Mesh elements only
     std::set<std::string> ambiguous_mesh_ids_;
-    std::set<std::string> unsupported_seen_;
 };
 
 }  // namespace detail::scene_loader
