@@ -1,7 +1,7 @@
 // Intersection benchmarks (Google Benchmark). Every triangle intersector (NaiveEpsilon,
 // Watertight, DoubleRefine) in float and double traces the same ray batches (primary, shadow,
 // diffuse) over two workloads: the largest hw1 course scene and the tiny-triangle dragon
-// (dragon_lowres subdivided to 766,144 triangles, made in process with prism-stress's code);
+// (dragon_lowres subdivided to 766,144 triangles, made in process by prism/scene/stress.hpp);
 // Embree 3 traces them too when it is installed (PRISM_BENCH_WITH_EMBREE). Also: BVH build
 // times, and paired time ratios between variants that stand up to a shared, noisy machine.
 //
@@ -15,9 +15,9 @@
 #include <prism/geometry/double_refine.hpp>
 #include <prism/geometry/naive_epsilon.hpp>
 #include <prism/geometry/scene_geometry.hpp>
-#include <prism/geometry/subdivide.hpp>
 #include <prism/geometry/watertight.hpp>
 #include <prism/io/load.hpp>
+#include <prism/scene/stress.hpp>
 
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
@@ -118,13 +118,42 @@ const prism::SceneGeometry<Real, prism::Bvh<Intersector>>& geometry_of(const Wor
     return *slot;
 }
 
+// Rounds to float and back through a volatile: without it, GCC 12.2 at -O3 compiled the primary
+// rays' Vec3<double>(Vec3<float>(direction)) into a copy of the doubles (its SLP vectorizer drops
+// the double(float(x)) pair, as in tests/test_leaks.cpp), and check_same_rays found all 131,044
+// primary rays of each workload unrounded in y and z.
+double through_float(double value) {
+    const volatile float rounded = float(value);
+    return double(rounded);
+}
+
+Vec3<double> through_float(const Vec3<double>& v) { return {through_float(v.x), through_float(v.y), through_float(v.z)}; }
+
 Ray<double> representable_in_float(const Ray<double>& ray) {
-    return {Vec3<double>(Vec3<float>(ray.origin)), Vec3<double>(Vec3<float>(ray.direction)),
-            double(float(ray.t_min)), double(float(ray.t_max))};
+    return {through_float(ray.origin), through_float(ray.direction), through_float(ray.t_min), through_float(ray.t_max)};
 }
 
 Ray<float> to_float(const Ray<double>& ray) {
     return {Vec3<float>(ray.origin), Vec3<float>(ray.direction), float(ray.t_min), float(ray.t_max)};
+}
+
+// The float and double batches must hold the same rays, or float and double variants would be
+// compared on different questions. Checked on the stored values after the fact, so that no
+// compiler rewrite of the rounding itself can hide a difference.
+void check_same_rays(const Workload& workload) {
+    std::size_t different = 0, total = 0;
+    for (const RayBatch& batch : workload.batches)
+        for (std::size_t i = 0; i < batch.rays.size(); ++i) {
+            const Ray<double>& exact = batch.rays[i];
+            const Ray<float>& rounded = batch.rays_float[i];
+            ++total;
+            if (Vec3<double>(rounded.origin) != exact.origin || Vec3<double>(rounded.direction) != exact.direction ||
+                double(rounded.t_min) != exact.t_min || double(rounded.t_max) != exact.t_max)
+                ++different;
+        }
+    if (different != 0)
+        throw std::runtime_error(workload.name + ": " + std::to_string(different) + " of " + std::to_string(total) +
+                                 " double rays are not exactly their float copies (the rounding was lost)");
 }
 
 // An orthonormal basis around a unit normal (Duff et al., "Building an Orthonormal Basis,
@@ -194,6 +223,7 @@ void make_batches(Workload& workload) {
     }
     for (RayBatch& batch : workload.batches)
         for (const Ray<double>& ray : batch.rays) batch.rays_float.push_back(to_float(ray));
+    check_same_rays(workload);
 }
 
 // The scene's meshes only, for a comparison with Embree on exactly the same triangles.
@@ -241,17 +271,10 @@ const Workload& course_workload() {
 const Workload& dragon_workload() {
     static const Workload workload = make_workload("dragon", [] {
         scene::Scene scene = meshes_only(prism::io::load_scene(dragon_scene_file));
-        const auto largest = std::max_element(scene.meshes.begin(), scene.meshes.end(), [](const auto& a, const auto& b) {
-            return a.triangles.size() < b.triangles.size();
-        });
-        prism::IndexedMesh<double> dragon = prism::subdivide_midpoint(prism::world_space_mesh(*largest), 3);
-        scene::Mesh mesh = *largest;
-        mesh.transform = glm::dmat4(1.0);
-        mesh.positions = std::move(dragon.positions);
-        mesh.triangles = std::move(dragon.triangles);
-        mesh.normals.clear();
-        mesh.uvs.clear();
-        scene.meshes = {std::move(mesh)};
+        const std::size_t dragon = scene::subdivide_largest_mesh(scene, 3);
+        scene::Mesh mesh = std::move(scene.meshes[dragon]);
+        scene.meshes.clear();  // the mirror floor
+        scene.meshes.push_back(std::move(mesh));
         return scene;
     });
     return workload;
