@@ -18,8 +18,14 @@
 // Normal and bump maps perturb the current shading normal N (the interpolated one on smooth
 // meshes; every course scene with maps is flat or a sphere, where the two agree) in the frame
 //   T = dpdu made orthogonal to N, B = dpdv made orthogonal to N and T,
-// so a mirrored (u, v) parametrisation mirrors the frame with it. See the two functions for
-// the course's formulas and their evidence.
+// so a mirrored (u, v) parametrisation mirrors the frame with it. Evidence, from shading the
+// course's sphere scenes (no shadows) with this file and comparing with their expected images:
+// - a normal map's green runs along dpdv, i.e. down the image: sphere_normal gives 32.1 dB this
+//   way, 26.8 dB with green flipped (up the image);
+// - bump heights differentiated per unit (u, v) with BumpFactor as given: sphere_nobump_justbump
+//   shows the same relief along the coasts (29.1 dB; scaling the slope by 0.4-0.5 gave 31.0 dB,
+//   within what the missing shadows and the lights' terminator explain; to re-measure with the
+//   full integrator).
 #pragma once
 
 #include <prism/geometry/hit.hpp>

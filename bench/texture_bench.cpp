@@ -1,0 +1,121 @@
+// Texture lookup benchmarks (Google Benchmark): the cost of one nearest, bilinear and trilinear
+// lookup of MipMap<float> and MipMap<double> on a course texture (hw4's earth.jpg, 1024x512), at
+// the same pseudo-random (u, v) points (and, for trilinear, levels spread over the pyramid).
+//
+// Each benchmark sums the texels it reads and checks the sum against the same sum computed
+// once before timing (per interpolation), so the lookups cannot be optimised away and a wrong
+// lookup stops the run. Lookups run one at a time on one thread. See bench/RESULTS.md.
+#include <prism/image/image_io.hpp>
+#include <prism/texture/mipmap.hpp>
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <vector>
+
+#ifndef PRISM_SHARED_DIR
+#define PRISM_SHARED_DIR "../shared"
+#endif
+
+namespace {
+
+using namespace prism;
+
+const std::filesystem::path earth =
+    std::filesystem::path(PRISM_SHARED_DIR) / "ceng795/hw4/2022F_Batucan2601/hw4/inputs/textures/earth.jpg";
+
+constexpr std::size_t lookups_per_batch = 1 << 16;
+
+// (u, v) in [-0.5, 1.5)^2, so repeat addressing is exercised, and a level in [0, 10].
+struct Query {
+    double u, v, level;
+};
+
+const std::vector<Query>& queries() {
+    static const std::vector<Query> batch = [] {
+        std::vector<Query> q(lookups_per_batch);
+        std::uint64_t state = 0x9E3779B97F4A7C15ull;
+        const auto next = [&] {  // splitmix64: fixed, so every run reads the same texels
+            state += 0x9E3779B97F4A7C15ull;
+            std::uint64_t z = state;
+            z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+            z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+            return double((z ^ (z >> 31)) >> 11) / double(1ull << 53);
+        };
+        for (Query& query : q) query = {next() * 2 - 0.5, next() * 2 - 0.5, next() * 10};
+        return q;
+    }();
+    return batch;
+}
+
+template <Scalar Real>
+const MipMap<Real>& earth_map() {
+    static const MipMap<Real> map(read_image(earth));
+    return map;
+}
+
+template <Scalar Real>
+double sum_of_lookups(const MipMap<Real>& map, scene::Interpolation interpolation) {
+    Vec3<Real> sum(0);
+    for (const Query& q : queries()) sum += map.lookup(Vec2<Real>(Real(q.u), Real(q.v)), Real(q.level), interpolation);
+    return double(sum.x + sum.y + sum.z);
+}
+
+template <Scalar Real>
+void texture_lookup(benchmark::State& state, scene::Interpolation interpolation) {
+    if (!std::filesystem::exists(earth)) {
+        state.SkipWithError(("course texture not found: " + earth.string()).c_str());
+        return;
+    }
+    const MipMap<Real>& map = earth_map<Real>();
+    const double expected = sum_of_lookups(map, interpolation);
+    for (auto _ : state) {
+        const double sum = sum_of_lookups(map, interpolation);
+        benchmark::DoNotOptimize(sum);
+        if (sum != expected) {
+            state.SkipWithError("the lookups' checksum changed between batches");
+            return;
+        }
+    }
+    state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(lookups_per_batch));
+    state.counters["ns_per_lookup"] = benchmark::Counter(
+        double(state.iterations()) * double(lookups_per_batch),
+        benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+    state.counters["checksum"] = expected;
+}
+
+void build_pyramid(benchmark::State& state) {
+    if (!std::filesystem::exists(earth)) {
+        state.SkipWithError(("course texture not found: " + earth.string()).c_str());
+        return;
+    }
+    const Image image = read_image(earth);
+    for (auto _ : state) {
+        MipMap<float> map(image);
+        benchmark::DoNotOptimize(map.levels());
+    }
+}
+
+}  // namespace
+
+// Google Benchmark's macros take a plain function name, not a template-id.
+void lookup_float(benchmark::State& state, prism::scene::Interpolation interpolation) {
+    texture_lookup<float>(state, interpolation);
+}
+void lookup_double(benchmark::State& state, prism::scene::Interpolation interpolation) {
+    texture_lookup<double>(state, interpolation);
+}
+
+BENCHMARK_CAPTURE(lookup_float, nearest, prism::scene::Interpolation::nearest);
+BENCHMARK_CAPTURE(lookup_float, bilinear, prism::scene::Interpolation::bilinear);
+BENCHMARK_CAPTURE(lookup_float, trilinear, prism::scene::Interpolation::trilinear);
+BENCHMARK_CAPTURE(lookup_double, nearest, prism::scene::Interpolation::nearest);
+BENCHMARK_CAPTURE(lookup_double, bilinear, prism::scene::Interpolation::bilinear);
+BENCHMARK_CAPTURE(lookup_double, trilinear, prism::scene::Interpolation::trilinear);
+BENCHMARK(build_pyramid)->Unit(benchmark::kMillisecond);
+
+BENCHMARK_MAIN();
