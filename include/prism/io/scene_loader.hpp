@@ -509,7 +509,9 @@ private:
             light.corner = position - 0.5 * (light.edge1 + light.edge2);
         }
         const Element* radiance = element.child("Radiance");
-        light.radiance = vector3(radiance != nullptr ? *radiance : required(element, "Intensity"));
+        if (radiance == nullptr) radiance = element.child("Intensity");
+        if (radiance == nullptr) fail(element, "missing <Radiance> (before 2019: <Intensity>)");
+        light.radiance = vector3(*radiance);
         const glm::dmat4 transform = transformation_of(element);
         light.corner = transform_point(transform, light.corner);
         light.edge1 = transform_direction(transform, light.edge1);
