@@ -595,51 +595,60 @@ TEST_CASE("faults in textures, images and the new lights name the file and the e
         INFO(name);
         check_fault(scenes.write(name, parts), element, words);
     };
-    const std::string mesh_with_texture_1 = "<Mesh id=\"1\"><Material>1</Material><Textures>1</Textures><Faces>1 2 3</Faces></Mesh>";
     Parts parts;
-    parts.objects = mesh_with_texture_1;
+    parts.objects = "<Mesh id=\"1\"><Material>1</Material><Textures>1</Textures><Faces>1 2 3</Faces></Mesh>";
 
     parts.textures = R"(<TextureMap id="1" type="perlin"><DecalMode>replace_kd</DecalMode></TextureMap>)";
     Parts unknown_texture = parts;
     unknown_texture.objects = "<Sphere id=\"1\"><Material>1</Material><Texture>1 9</Texture><Center>4</Center><Radius>1</Radius></Sphere>";
     fault("unknown_texture.xml", unknown_texture, "<Texture>", "unknown texture id \"9\"");
 
-    parts.textures = R"(<TextureMap id="1" type="image"><ImageId>3</ImageId></TextureMap>)";
-    fault("unknown_image.xml", parts, "<ImageId>", "unknown image id \"3\"");
-    parts.textures = R"(<Images><Image id="1">nowhere.png</Image></Images>
-        <TextureMap id="1" type="image"><ImageId>1</ImageId></TextureMap>)";
-    fault("missing_image.xml", parts, "<Image id=\"1\">", "nowhere.png: no such image file");
-    parts.textures = R"(<Texture id="1"><ImageName>textures/nowhere.jpg</ImageName><DecalMode>replace_kd</DecalMode></Texture>)";
-    fault("missing_legacy_image.xml", parts, "<ImageName>", "nowhere.jpg: no such image file");
-    parts.textures = R"(<Images><Image id="1">broken.png</Image></Images>
-        <TextureMap id="1" type="image"><ImageId>1</ImageId></TextureMap>)";
-    fault("undecodable_image.xml", parts, "<Image id=\"1\">", "cannot read the image");
-    parts.textures = R"(<Images><Image id="1">textures/small.gif</Image></Images>)";
-    fault("unknown_image_format.xml", parts, "<Image id=\"1\">", "unsupported image format");
-
-    parts.textures = R"(<TextureMap id="1" type="perlin"><DecalMode>replace_diffuse</DecalMode></TextureMap>)";
-    fault("unknown_decal_mode.xml", parts, "<DecalMode>", "unknown decal mode \"replace_diffuse\"");
-    parts.textures = R"(<TextureMap id="1" type="marble"><DecalMode>replace_kd</DecalMode></TextureMap>)";
-    fault("unknown_texture_type.xml", parts, "<TextureMap id=\"1\">", "unknown texture type \"marble\"");
-    parts.textures = R"(<TextureMap id="1" type="image"><ImageId>1</ImageId><Interpolation>bicubic</Interpolation></TextureMap>)";
-    fault("unknown_interpolation.xml", parts, "<Interpolation>", "unknown interpolation \"bicubic\"");
-    parts.textures = R"(<TextureMap id="1" type="perlin"><NoiseConversion>abs</NoiseConversion></TextureMap>)";
-    fault("unknown_noise_conversion.xml", parts, "<NoiseConversion>", "unknown noise conversion");
-    parts.textures = R"(<Texture id="1"><ImageName>perlin</ImageName><Appearance>marble</Appearance></Texture>)";
-    fault("unknown_appearance.xml", parts, "<Appearance>", "unknown Perlin appearance");
-    parts.textures = R"(<TextureMap id="1" type="checkerboard"><Scale>-2</Scale></TextureMap>)";
-    fault("negative_scale.xml", parts, "<Scale>", "must be positive");
-    parts.textures = R"(<TextureMap id="1" type="perlin"><NoiseScale>nan</NoiseScale></TextureMap>)";
-    fault("nan_noise_scale.xml", parts, "<NoiseScale>", "not a finite number");
-    parts.textures = R"(<TextureMap id="1" type="perlin"><NumOctaves>0</NumOctaves></TextureMap>)";
-    fault("zero_octaves.xml", parts, "<NumOctaves>", "at least 1");
-    parts.textures = R"(<Texture id="1" bumpmap="yes"><ImageName>perlin</ImageName></Texture>)";
-    fault("bad_bumpmap.xml", parts, "<Texture id=\"1\">", "bumpmap");
-    parts.textures = R"(<TextureMap id="1" type="perlin"/><TextureMap id="1" type="checkerboard"/>)";
-    fault("duplicate_texture.xml", parts, "<TextureMap id=\"1\">", "already defined");
-    parts.textures = R"(<TextureMap id="1" type="perlin"><DecalMode>replace_background</DecalMode></TextureMap>
-        <TextureMap id="2" type="checkerboard"><DecalMode>replace_background</DecalMode></TextureMap>)";
-    fault("two_backgrounds.xml", parts, "<TextureMap id=\"2\">", "second replace_background");
+    // A scene whose mesh names texture 1, with these <Textures> contents.
+    struct TextureFault {
+        std::string file, textures;
+        std::string_view element, words;
+    };
+    const TextureFault texture_faults[] = {
+        {"unknown_image.xml", R"(<TextureMap id="1" type="image"><ImageId>3</ImageId></TextureMap>)",
+         "<ImageId>", "unknown image id \"3\""},
+        {"missing_image.xml", R"(<Images><Image id="1">nowhere.png</Image></Images>
+        <TextureMap id="1" type="image"><ImageId>1</ImageId></TextureMap>)",
+         "<Image id=\"1\">", "nowhere.png: no such image file"},
+        {"missing_legacy_image.xml", R"(<Texture id="1"><ImageName>textures/nowhere.jpg</ImageName><DecalMode>replace_kd</DecalMode></Texture>)",
+         "<ImageName>", "nowhere.jpg: no such image file"},
+        {"undecodable_image.xml", R"(<Images><Image id="1">broken.png</Image></Images>
+        <TextureMap id="1" type="image"><ImageId>1</ImageId></TextureMap>)",
+         "<Image id=\"1\">", "cannot read the image"},
+        {"unknown_image_format.xml", R"(<Images><Image id="1">textures/small.gif</Image></Images>)",
+         "<Image id=\"1\">", "unsupported image format"},
+        {"unknown_decal_mode.xml", R"(<TextureMap id="1" type="perlin"><DecalMode>replace_diffuse</DecalMode></TextureMap>)",
+         "<DecalMode>", "unknown decal mode \"replace_diffuse\""},
+        {"unknown_texture_type.xml", R"(<TextureMap id="1" type="marble"><DecalMode>replace_kd</DecalMode></TextureMap>)",
+         "<TextureMap id=\"1\">", "unknown texture type \"marble\""},
+        {"unknown_interpolation.xml", R"(<TextureMap id="1" type="image"><ImageId>1</ImageId><Interpolation>bicubic</Interpolation></TextureMap>)",
+         "<Interpolation>", "unknown interpolation \"bicubic\""},
+        {"unknown_noise_conversion.xml", R"(<TextureMap id="1" type="perlin"><NoiseConversion>abs</NoiseConversion></TextureMap>)",
+         "<NoiseConversion>", "unknown noise conversion"},
+        {"unknown_appearance.xml", R"(<Texture id="1"><ImageName>perlin</ImageName><Appearance>marble</Appearance></Texture>)",
+         "<Appearance>", "unknown Perlin appearance"},
+        {"negative_scale.xml", R"(<TextureMap id="1" type="checkerboard"><Scale>-2</Scale></TextureMap>)",
+         "<Scale>", "must be positive"},
+        {"nan_noise_scale.xml", R"(<TextureMap id="1" type="perlin"><NoiseScale>nan</NoiseScale></TextureMap>)",
+         "<NoiseScale>", "not a finite number"},
+        {"zero_octaves.xml", R"(<TextureMap id="1" type="perlin"><NumOctaves>0</NumOctaves></TextureMap>)",
+         "<NumOctaves>", "at least 1"},
+        {"bad_bumpmap.xml", R"(<Texture id="1" bumpmap="yes"><ImageName>perlin</ImageName></Texture>)",
+         "<Texture id=\"1\">", "bumpmap"},
+        {"duplicate_texture.xml", R"(<TextureMap id="1" type="perlin"/><TextureMap id="1" type="checkerboard"/>)",
+         "<TextureMap id=\"1\">", "already defined"},
+        {"two_backgrounds.xml", R"(<TextureMap id="1" type="perlin"><DecalMode>replace_background</DecalMode></TextureMap>
+        <TextureMap id="2" type="checkerboard"><DecalMode>replace_background</DecalMode></TextureMap>)",
+         "<TextureMap id=\"2\">", "second replace_background"},
+    };
+    for (const TextureFault& texture_fault : texture_faults) {
+        parts.textures = texture_fault.textures;
+        fault(texture_fault.file, parts, texture_fault.element, texture_fault.words);
+    }
 
     Parts lights;
     lights.lights = R"(<AreaLight id="1"><Position>0 0 0</Position><Normal>0 -1 0</Normal><Size>-3</Size><Radiance>1 1 1</Radiance></AreaLight>)";
