@@ -8,6 +8,8 @@
 #include <prism/image/image_io.hpp>
 #include <prism/image/tonemap.hpp>
 #include <prism/light/environment_light.hpp>
+#include <prism/light/light_set.hpp>
+#include <prism/light/point_light.hpp>
 #include <prism/light/procedural_sky.hpp>
 #include <prism/sampling/piecewise_constant.hpp>
 #include <prism/sampling/random.hpp>
@@ -473,6 +475,24 @@ TEST_CASE("EnvironmentLight and EnvironmentBackground from a scene") {
     CHECK(background.radiance({0, 1, 0}) == Vec3<float>(2.0f, 1.0f, 0.5f));
     CHECK(shared.radiance({1, 0, 0}) == Vec3<float>(2.0f, 1.0f, 0.5f));
     CHECK_FALSE(prism::EnvironmentBackground<float>().present());
+
+    // In a light set beside other types, as a renderer's Config would hold it.
+    const prism::LightSet<double, prism::PointLight, prism::EnvironmentLight> set(description);
+    CHECK(set.size() == 1);
+    CHECK(prism::Lights<prism::PointLight, prism::EnvironmentLight>::count_in(description) == 1);
+    int visited = 0;
+    set.for_each([&](const auto& light) {
+        const auto sample = light.sample({Vec3<double>(0), Vec3<double>(0, 1, 0)}, Vec2<double>(0.25, 0.5));
+        CHECK(sample.radiance.g > 0);
+        CHECK(std::isinf(sample.distance));
+        ++visited;
+    });
+    CHECK(visited == 1);
+    const auto* environment = set.of_type<prism::EnvironmentLight>();
+    REQUIRE(environment != nullptr);
+    const prism::ShadingFrame<double> up{Vec3<double>(0), Vec3<double>(0, 1, 0)};
+    const auto sample = environment->front().sample(up, Vec2<double>(0.25, 0.5));
+    CHECK(sample.radiance.g == doctest::Approx(1.0 / environment->front().pdf(up, sample.direction)));  // L = 2 * 0.5
 
     description.environment_lights[0].image = 3;
     CHECK_THROWS_AS(prism::EnvironmentLight<float>::from_scene(description), prism::io::LoadError);
