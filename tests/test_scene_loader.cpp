@@ -70,6 +70,20 @@ constexpr KnownBroken known_broken[] = {
     {"hw2/2018S_emrebarisc/Sources/3 - Instancing, Transformation, Distribution/Scenes/instanced_bunny.xml",
      "already defined",
      "two <Translation id=\"1\">, and references to t2, t3 and material 3, which no element defines"},
+    {"hw4/2019S_EgeCiklabakkal/inputs/hw4/bump_mapping_basic.xml", "no such image file",
+     "its textures/ folder was not published with the scene"},
+    {"hw4/2019S_EgeCiklabakkal/inputs/hw4/bump_mapping_basic_nobump.xml", "no such image file",
+     "its textures/ folder was not published with the scene"},
+    {"hw4/2019S_EgeCiklabakkal/inputs/hw4/bump_mapping_transformed_nobump.xml", "no such image file",
+     "its textures/ folder was not published with the scene"},
+    {"hw4/2019S_EgeCiklabakkal/inputs/hw4/sphere_bump_nobump.xml", "no such image file",
+     "its textures/ folder was not published with the scene"},
+    {"hw4/2019S_EgeCiklabakkal/inputs/hw4/sphere_texture_blend_bilinear.xml", "no such image file",
+     "its textures/ folder was not published with the scene"},
+    {"hw4/2019S_EgeCiklabakkal/inputs/hw4/sphere_texture_replace_bilinear.xml", "no such image file",
+     "its textures/ folder was not published with the scene"},
+    {"hw4/2019S_EgeCiklabakkal/inputs/hw4/sphere_texture_replace_nearest.xml", "no such image file",
+     "its textures/ folder was not published with the scene"},
 };
 
 const KnownBroken* find_known_broken(std::string_view path) {
@@ -581,12 +595,12 @@ TEST_CASE("unsupported elements are named once each and skipped") {
     SceneParts parts;
     parts.objects += R"(<LightSphere id="1"><Material>1</Material><Center>1</Center><Radius>1</Radius><Radiance>1 1 1</Radiance></LightSphere>
         <LightSphere id="2"><Material>1</Material><Center>1</Center><Radius>1</Radius><Radiance>1 1 1</Radiance></LightSphere>
-        <Sphere id="1"><Material>1</Material><Center>1</Center><Radius>0.5</Radius><MotionBlur>0 0 1</MotionBlur></Sphere>)";
+        <Sphere id="1"><Material>1</Material><Center>1</Center><Radius>0.5</Radius></Sphere>)";
     std::string xml = scene_xml(parts);
-    xml.replace(xml.find("</Lights>"), 0, "<AreaLight id=\"1\"><Position>0 0 0</Position></AreaLight>\n");
+    xml.replace(xml.find("</Lights>"), 0, "<LightMesh id=\"1\"><Material>1</Material></LightMesh>\n");
     xml.replace(xml.find("</Scene>"), 0, "<Textures></Textures>\n<BRDFs><OriginalPhong id=\"1\"><Exponent>2</Exponent></OriginalPhong></BRDFs>\n");
     const Scene scene = load_scene(folder.write("later_topics.xml", xml));
-    CHECK(scene.unsupported == std::vector<std::string>{"AreaLight", "LightSphere", "MotionBlur", "BRDFs"});
+    CHECK(scene.unsupported == std::vector<std::string>{"LightMesh", "LightSphere", "BRDFs"});
     CHECK(scene.spheres.size() == 1);
     CHECK(scene.point_lights.size() == 1);
 }

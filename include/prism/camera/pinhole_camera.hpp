@@ -42,6 +42,7 @@ public:
     const Vec3<Real>& right() const { return u_; }
     const Vec3<Real>& up() const { return v_; }
     const Vec3<Real>& forward() const { return forward_; }
+    Real pixel_spread() const { return glm::length(step_v_) / glm::length(top_left_ + step_u_ * Real(width_ / 2) + step_v_ * Real(height_ / 2)); }
 
 private:
     int width_, height_;

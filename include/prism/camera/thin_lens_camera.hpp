@@ -19,6 +19,8 @@ public:
     int width() const { return pinhole_.width(); }
     int height() const { return pinhole_.height(); }
     bool has_aperture() const { return aperture_ > 0; }
+    // The angle one pixel subtends at the image centre: the spread of a pixel's ray cone.
+    Real pixel_spread() const { return pinhole_.pixel_spread(); }
 
     // The ray through the continuous image position (x, y) (as PinholeCamera::ray) leaving the
     // lens at `lens` in [0, 1)^2, at shutter instant `time`.

@@ -11,6 +11,7 @@
 #include <prism/image/image.hpp>
 #include <prism/render/config.hpp>
 #include <prism/render/whitted_integrator.hpp>
+#include <prism/texture/texture_set.hpp>
 
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
@@ -36,7 +37,7 @@ public:
     static constexpr Features features = C::features;
     using Geometry = SceneGeometry<Real, typename C::Acceleration, features.motion_blur>;
     using LightSetT = typename C::LightTypes::template Set<Real>;
-    using TexturesT = NoTextures<Real>;
+    using TexturesT = std::conditional_t<features.textures, TextureSet<Real>, NoTextures<Real>>;
     using EnvironmentT = NoEnvironment<Real>;
     using Integrator = WhittedIntegrator<Real, Geometry, LightSetT, TexturesT, EnvironmentT>;
 
@@ -82,7 +83,8 @@ public:
     // lights and roughness are sampled from the stream of pixel (0, 0).
     Vec3<Real> radiance(const Ray<Real>& ray) const {
         Random random = Random::for_pixel(0, 0, settings_.seed);
-        return integrator_.radiance(ray, random, Vec2<Real>(Real(0.5)));
+        typename Integrator::CameraPath path{random, Vec2<Real>(Real(0.5))};
+        return integrator_.radiance(ray, path);
     }
 
 private:
@@ -90,13 +92,15 @@ private:
                     std::vector<CameraSample<Real>>& samples, std::vector<Vec2<Real>>& scratch) const {
         Random random = Random::for_pixel(x, y, settings_.seed);
         camera_samples(count, random, samples, scratch);
-        const Vec2<Real> pixel_uv((Real(x) + Real(0.5)) / Real(lens.width()), (Real(y) + Real(0.5)) / Real(lens.height()));
+        typename Integrator::CameraPath path{
+            random, Vec2<Real>((Real(x) + Real(0.5)) / Real(lens.width()), (Real(y) + Real(0.5)) / Real(lens.height())),
+            lens.pixel_spread()};
         Vec3<Real> sum(0);
         Real weights = 0;
         for (const CameraSample<Real>& sample : samples) {
             const Ray<Real> ray = lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time);
             const Real weight = filter_weight(filter, sample.pixel);
-            sum += weight * integrator_.radiance(ray, random, pixel_uv);
+            sum += weight * integrator_.radiance(ray, path);
             weights += weight;
         }
         return glm::vec3(sum / weights);

@@ -11,8 +11,10 @@
 #include <prism/material/fresnel.hpp>
 #include <prism/material/material.hpp>
 #include <prism/sampling/random.hpp>
+#include <prism/texture/mipmap.hpp>
 
 #include <cmath>
+#include <optional>
 #include <vector>
 
 namespace prism {
@@ -35,12 +37,14 @@ struct IntegratorSettings {
 
 // A surface's textures as the integrator uses them; `NoTextures` is the policy of renderers
 // compiled without texture support, and costs nothing.
+// The interface is TextureSet's (texture/texture_set.hpp): apply() changes the material and
+// the shading normal and may return an unshaded colour (replace_all); background() is the
+// replace_background texture at the pixel.
 template <Scalar Real>
 struct NoTextures {
     explicit NoTextures(const scene::Scene&) {}
-    void apply(SurfacePoint<Real>&, Material<Real>&) const {}
-    bool has_background() const { return false; }
-    Vec3<Real> background(const Vec2<Real>&) const { return Vec3<Real>(0); }
+    std::optional<Vec3<Real>> apply(SurfacePoint<Real>&, Material<Real>&, const RayCone<Real>&) const { return {}; }
+    std::optional<Vec3<Real>> background(const Vec2<Real>&) const { return {}; }
 };
 
 // What escaping rays see, for renderers without environment lights: the background colour for
@@ -77,22 +81,32 @@ public:
           ambient_light_(ambient_light), background_(background), settings_(settings),
           epsilon_(Real(settings.shadow_ray_epsilon)) {}
 
-    // Radiance arriving along a camera ray with a unit direction. `pixel_uv` is the pixel's
-    // position in [0, 1]^2 from the top left, where a background texture is looked up.
-    Vec3<Real> radiance(const Ray<Real>& ray, Random& random, const Vec2<Real>& pixel_uv) const {
-        return trace(ray, 0, random, pixel_uv);
-    }
+    // What a camera ray carries down its recursion besides the ray itself.
+    struct CameraPath {
+        Random& random;      // the pixel's stream
+        Vec2<Real> pixel_uv; // the pixel's position in [0, 1]^2 from the top left (background texture)
+        Real spread = 0;     // the pixel's angular size: the ray cone's spread (trilinear textures)
+    };
+
+    // Radiance arriving along a camera ray with a unit direction.
+    Vec3<Real> radiance(const Ray<Real>& ray, CameraPath& path) const { return trace(ray, 0, path, Real(0)); }
 
 private:
-    Vec3<Real> trace(Ray<Real> ray, int depth, Random& random, const Vec2<Real>& pixel_uv) const {
+    // `travelled`: the distance from the camera to the ray's origin along the path, which widens
+    // the ray cone like a pinhole's (mirrors are treated as flat: Ray Tracing Gems ch. 20's
+    // simplest variant).
+    Vec3<Real> trace(Ray<Real> ray, int depth, CameraPath& path, Real travelled) const {
         Hit<Real> hit;
         const bool found = (depth == 0 && settings_.cull_backfaces) ? geometry_.template intersect<true>(ray, hit)
                                                                     : geometry_.template intersect<false>(ray, hit);
-        if (!found) return escaped(ray.direction, depth, pixel_uv);
+        if (!found) return escaped(ray.direction, depth, path.pixel_uv);
 
         SurfacePoint<Real> point = geometry_.surface(ray, hit);
         Material<Real> material = materials_[point.material];
-        textures_.apply(point, material);
+        travelled += hit.t;
+        const RayCone<Real> cone{travelled * path.spread, std::abs(glm::dot(ray.direction, point.shading_normal))};
+        if (const std::optional<Vec3<Real>> unshaded = textures_.apply(point, material, cone)) return *unshaded;
+        Random& random = path.random;
         const Vec3<Real>& d = ray.direction;
         const bool front_face = glm::dot(point.geometric_normal, d) < 0;
         // Shading uses the normal on the side the ray arrives from.
@@ -118,17 +132,17 @@ private:
             switch (material.type) {
                 case MaterialType::blinn_phong: break;
                 case MaterialType::mirror:
-                    color += material.mirror * trace(reflection, depth + 1, random, pixel_uv);
+                    color += material.mirror * trace(reflection, depth + 1, path, travelled);
                     break;
                 case MaterialType::conductor: {
                     const Real fresnel = fresnel_conductor(std::max(cos_incident, Real(0)), material.refraction_index,
                                                            material.absorption_index);
-                    color += fresnel * material.mirror * trace(reflection, depth + 1, random, pixel_uv);
+                    color += fresnel * material.mirror * trace(reflection, depth + 1, path, travelled);
                     break;
                 }
                 case MaterialType::dielectric:
                     color += dielectric(point, d, normal, cos_incident, front_face, material, reflection, depth,
-                                        random, pixel_uv);
+                                        path, travelled);
                     break;
             }
         }
@@ -145,7 +159,9 @@ private:
     // colour); the course's secondary rays bring back nothing unless an environment surrounds
     // the scene.
     Vec3<Real> escaped(const Vec3<Real>& direction, int depth, const Vec2<Real>& pixel_uv) const {
-        if (depth == 0 && textures_.has_background()) return textures_.background(pixel_uv);
+        if (depth == 0) {
+            if (const std::optional<Vec3<Real>> texture = textures_.background(pixel_uv)) return *texture;
+        }
         if (environment_.present()) return environment_.radiance(direction);
         return depth == 0 ? background_ : Vec3<Real>(0);
     }
@@ -190,21 +206,22 @@ private:
 
     Vec3<Real> dielectric(const SurfacePoint<Real>& point, const Vec3<Real>& d, const Vec3<Real>& normal,
                           Real cos_incident, bool front_face, const Material<Real>& material,
-                          const Ray<Real>& reflection, int depth, Random& random, const Vec2<Real>& pixel_uv) const {
+                          const Ray<Real>& reflection, int depth, CameraPath& path, Real travelled) const {
         const Real n1 = front_face ? Real(1) : material.refraction_index;
         const Real n2 = front_face ? material.refraction_index : Real(1);
         const Real ratio = n1 / n2;
         const Real sin2_transmitted = ratio * ratio * (1 - cos_incident * cos_incident);
-        if (sin2_transmitted >= 1) return trace(reflection, depth + 1, random, pixel_uv);  // total internal reflection
+        if (sin2_transmitted >= 1) return trace(reflection, depth + 1, path, travelled);  // total internal reflection
         const Real cos_transmitted = std::sqrt(1 - sin2_transmitted);
         const Real fresnel = fresnel_dielectric(cos_incident, cos_transmitted, n1, n2);
         Vec3<Real> transmitted = glm::normalize(ratio * d + (ratio * cos_incident - cos_transmitted) * normal);
+        Random& random = path.random;
         if (material.roughness > 0) transmitted = perturb(transmitted, material.roughness, random.uniform2<Real>());
         const Ray<Real> refraction = leaving(point, normal, transmitted, reflection.time);
-        Vec3<Real> through = (1 - fresnel) * trace(refraction, depth + 1, random, pixel_uv);
+        Vec3<Real> through = (1 - fresnel) * trace(refraction, depth + 1, path, travelled);
         // Pre-2020 scenes describe glass by a Transparency colour that filters what passes.
         if (material.transparency != Vec3<Real>(0)) through *= material.transparency;
-        return fresnel * trace(reflection, depth + 1, random, pixel_uv) + through;
+        return fresnel * trace(reflection, depth + 1, path, travelled) + through;
     }
 
     const Geometry& geometry_;
