@@ -114,6 +114,24 @@ void check_mapping(ToImage to_image, ToDirection to_direction, const Vec2<Real> 
     }
 }
 
+// Pearson's statistic of the counts drawn from a table against the table's proportions, over
+// its non-zero cells; a zero cell must never be drawn.
+template <class Real>
+double pearson_chi_square(const std::vector<Real>& table, const std::vector<int>& hits, int count) {
+    double total = 0;
+    for (const Real value : table) total += double(value);
+    double chi_square = 0;
+    for (std::size_t i = 0; i < table.size(); ++i) {
+        if (table[i] == 0) {
+            CHECK(hits[i] == 0);
+            continue;
+        }
+        const double expected = count * double(table[i]) / total;
+        chi_square += (hits[i] - expected) * (hits[i] - expected) / expected;
+    }
+    return chi_square;
+}
+
 }  // namespace
 
 TEST_CASE_TEMPLATE("lat-long mapping: the course's axes and round trips", Real, float, double) {
@@ -195,15 +213,7 @@ TEST_CASE_TEMPLATE("piecewise-constant 1D: density, frequencies and the inverse 
         CHECK(sample.pdf == doctest::Approx(double(distribution.pdf(sample.x))));
         CHECK(double(distribution.cdf(sample.x)) == doctest::Approx(double(u)).epsilon(1e-5));  // inverse of sample()
     }
-    double chi_square = 0;
-    for (std::size_t i = 0; i < table.size(); ++i) {
-        if (table[i] == 0) {
-            CHECK(hits[i] == 0);
-            continue;
-        }
-        const double expected = count * double(table[i]) / total;
-        chi_square += (hits[i] - expected) * (hits[i] - expected) / expected;
-    }
+    const double chi_square = pearson_chi_square(table, hits, count);
     CHECK(chi_square < 18.5);
 
     // A table of zeros becomes uniform instead of dividing by zero.
@@ -243,15 +253,7 @@ TEST_CASE_TEMPLATE("piecewise-constant 2D: density, frequencies and the inverse 
         CHECK(double(back.y) == doctest::Approx(double(u.y)).epsilon(1e-4));
     }
     // 8 non-zero cells: 7 degrees of freedom, 24.3 is the 99.9% quantile.
-    double chi_square = 0;
-    for (std::size_t i = 0; i < table.size(); ++i) {
-        if (table[i] == 0) {
-            CHECK(hits[i] == 0);
-            continue;
-        }
-        const double expected = count * double(table[i]) / total;
-        chi_square += (hits[i] - expected) * (hits[i] - expected) / expected;
-    }
+    const double chi_square = pearson_chi_square(table, hits, count);
     CHECK(chi_square < 24.3);
 }
 
