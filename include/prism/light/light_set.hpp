@@ -51,6 +51,10 @@ template <template <class> class... LightTypes>
 struct Lights {
     template <Scalar Real> using Set = LightSet<Real, LightTypes...>;
 
+    // Whether the set holds light type `Type` (code for it is compiled in only then).
+    template <template <class> class Type>
+    static constexpr bool contains = (std::is_same_v<Type<float>, LightTypes<float>> || ...);
+
     // How many of the scene's lights this set can represent; a dispatcher compares it with the
     // scene's total so that no light is silently dropped.
     static std::size_t count_in(const scene::Scene& scene) {

@@ -7,6 +7,7 @@
 #include <prism/image/image.hpp>
 #include <prism/light/area_light.hpp>
 #include <prism/light/directional_light.hpp>
+#include <prism/light/environment_light.hpp>
 #include <prism/light/point_light.hpp>
 #include <prism/light/spot_light.hpp>
 #include <prism/render/renderer.hpp>
@@ -86,7 +87,7 @@ inline Choice choose_precision(const scene::Scene& scene, const RenderOptions& o
 // (each costs about 20 s of compile time on two cores); bench/ measures what the fitted one
 // saves.
 using PointLightSet = Lights<PointLight>;
-using AllLightSet = Lights<PointLight, DirectionalLight, SpotLight, AreaLight>;
+using AllLightSet = Lights<PointLight, DirectionalLight, SpotLight, AreaLight, EnvironmentLight>;
 inline constexpr Features no_features{};
 inline constexpr Features all_features{.textures = true, .motion_blur = true};
 

@@ -9,6 +9,7 @@
 #include <prism/camera/thin_lens_camera.hpp>
 #include <prism/geometry/scene_geometry.hpp>
 #include <prism/image/image.hpp>
+#include <prism/light/environment_light.hpp>
 #include <prism/render/config.hpp>
 #include <prism/render/whitted_integrator.hpp>
 #include <prism/texture/texture_set.hpp>
@@ -38,14 +39,15 @@ public:
     using Geometry = SceneGeometry<Real, typename C::Acceleration, features.motion_blur>;
     using LightSetT = typename C::LightTypes::template Set<Real>;
     using TexturesT = std::conditional_t<features.textures, TextureSet<Real>, NoTextures<Real>>;
-    using EnvironmentT = NoEnvironment<Real>;
+    static constexpr bool environment_lights = C::LightTypes::template contains<EnvironmentLight>;
+    using EnvironmentT = std::conditional_t<environment_lights, EnvironmentBackground<Real>, NoEnvironment<Real>>;
     using Integrator = WhittedIntegrator<Real, Geometry, LightSetT, TexturesT, EnvironmentT>;
 
     static constexpr int tile_size = 16;
 
     explicit Renderer(const scene::Scene& scene, const RendererSettings& settings = {})
         : geometry_(check_features(scene)), lights_(scene), materials_(convert_materials(scene)), textures_(scene),
-          settings_(settings),
+          environment_(make_environment(lights_)), settings_(settings),
           integrator_(geometry_, lights_, materials_, textures_, environment_, Vec3<Real>(scene.ambient_light),
                       Vec3<Real>(scene.background_color),
                       IntegratorSettings{scene.max_recursion_depth, scene.shadow_ray_epsilon, settings.ray_offset,
@@ -124,6 +126,13 @@ private:
                 throw std::invalid_argument("the scene has textures, and this renderer was compiled without them");
         }
         return scene;
+    }
+
+    // The environment lights' images are also the background for rays that escape; the
+    // background shares them rather than loading them again.
+    static EnvironmentT make_environment(const LightSetT& lights) {
+        if constexpr (environment_lights) return EnvironmentT(*lights.template of_type<EnvironmentLight>());
+        else return EnvironmentT{};
     }
 
     static std::vector<Material<Real>> convert_materials(const scene::Scene& scene) {
