@@ -206,10 +206,11 @@ TEST_CASE("render_scene: a light set without the scene's light type refuses the 
         (prism::detail::render_with<prism::Config<float, prism::Bvh<prism::Watertight>, prism::PointLightSet>>(
             world, prism::RenderOptions{}, log, ignore)),
         doctest::Contains("can render only 0"), std::invalid_argument);
-    // The dispatcher picks the punctual set for it, and says so.
+    // The dispatcher picks the complete renderer for it, and says why.
     const auto images = prism::render_scene(world, prism::RenderOptions{}, log);
     CHECK(images.size() == 1);
-    CHECK(contains(log.str(), "directional and spot lights"));
+    CHECK(contains(log.str(), "all light types"));
+    CHECK(contains(log.str(), "the scene has spot lights"));
 }
 
 // ---- the loader -----------------------------------------------------------------------------
