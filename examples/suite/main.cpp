@@ -58,9 +58,9 @@ options:
                        is box-filtered down to the render's size before comparing
   --max-samples N      at most N samples per pixel, whatever NumSamples says
   --threshold DB       PSNR a judged image must reach to pass (default 40)
-  --require LEVEL      high | medium | any: the least reference confidence that is judged
-                       (default high); images with weaker references are listed as `info`
-                       and never fail
+  --require LEVEL      high | medium | any | none: the least reference confidence that is
+                       judged (default high); images with weaker references are listed as
+                       `info` and never fail (none: report every PSNR, judge nothing)
   --output-dir DIR     write every render to DIR/TOPIC/SCENE-FORMAT/IMAGE_NAME
   --threads N          worker threads (default: all hardware threads)
   --precision P        float | double-refine | double: override the precision chosen from
@@ -146,7 +146,8 @@ Arguments parse_arguments(int argc, char** argv) {
             if (level == "high") arguments.required_rank = 3;
             else if (level == "medium") arguments.required_rank = 2;
             else if (level == "any") arguments.required_rank = 0;
-            else command_line.usage_error("--require must be high, medium or any");
+            else if (level == "none") arguments.required_rank = 4;  // above every confidence
+            else command_line.usage_error("--require must be high, medium, any or none");
         } else if (arg == "--output-dir") {
             arguments.output_dir = fs::path(value());
         } else if (arg == "--verbose") {
@@ -510,7 +511,8 @@ int main(int argc, char** argv) {
         for (const Reference& reference : job.references)
             widths.image = std::max(widths.image, reference.path.filename().string().size());
     }
-    const char* judged = arguments.required_rank == 3   ? "[high]"
+    const char* judged = arguments.required_rank == 4   ? "no"
+                         : arguments.required_rank == 3 ? "[high]"
                          : arguments.required_rank == 2 ? "[high] and [medium]"
                                                         : "all";
     std::cout << "prism-suite: " << jobs.size() << (jobs.size() == 1 ? " scene" : " scenes") << " from "
