@@ -5,6 +5,7 @@
 
 #include <prism/image/compare.hpp>
 #include <prism/image/image_io.hpp>
+#include <prism/image/tonemap.hpp>
 #include <prism/io/load.hpp>
 #include <prism/render/progress.hpp>
 #include <prism/render/render_scene.hpp>
@@ -36,7 +37,8 @@ constexpr const char* usage = R"(usage: prism-suite (MANIFEST.tsv | FOLDER) [opt
 Renders every selected scene, compares each camera's image with its expected image and prints
 a table: topic, scene, format, image, size, render seconds, PSNR (dB), share of pixels off by
 more than 8/255 in any channel (%), status and a note. Both images are compared as the 8-bit
-values a PNG holds (radiance clamped to 0..255 and rounded).
+values a PNG holds (radiance clamped to 0..255 and rounded). A camera with Tonemaps is compared
+file by file: each tone-mapped PNG against the reference of its exact name.
 
 MANIFEST.tsv  a tab-separated manifest with the columns topic, scene, format, path and
               references (like ceng795/MANIFEST.tsv); paths are relative to its folder;
@@ -428,38 +430,48 @@ void run_job(const Arguments& arguments, const Job& job, std::size_t index, std:
         std::vector<bool> reference_used(job.references.size(), false);
         for (const prism::CameraImage& rendered : images) {
             const prism::scene::Camera& camera = scene.cameras[rendered.camera];
-            const fs::path image_name = rendered.image_name.empty() ? fs::path("camera_" + camera.id + ".png")
-                                                                    : fs::path(rendered.image_name).filename();
-            Row row = scene_row;
-            row.image = image_name.string();
-            row.size = std::to_string(rendered.image.width) + "x" + std::to_string(rendered.image.height);
-            row.seconds = fixed(rendered.seconds, 2);
-            const std::optional<Reference> reference = find_reference(job, image_name, scene.cameras.size());
-            if (reference) {
-                for (std::size_t r = 0; r < job.references.size(); ++r)
-                    if (job.references[r].path == reference->path || same_stem(job.references[r].path, image_name))
-                        reference_used[r] = true;
-                row = compare_image(arguments, camera, rendered, *reference, row);
-            } else {
-                row.status = "rendered";
-            }
-            if (arguments.output_dir) {
-                const fs::path output = *arguments.output_dir / job.output_subfolder / image_name;
-                std::error_code error;
-                if (reference && fs::equivalent(output, reference->path, error)) {
-                    row.note += std::string(row.note.empty() ? "" : "; ") + "not written over its reference";
+            // Every file the camera writes is compared: the raw image, and each Tonemap's PNG
+            // (tone-mapped from the same render, as `prism` writes them).
+            std::vector<prism::CameraOutput> outputs = prism::camera_outputs(camera);
+            if (rendered.image_name.empty()) outputs = {{fs::path("camera_" + camera.id + ".png"), std::nullopt}};
+            for (const prism::CameraOutput& output : outputs) {
+                const fs::path image_name = output.name.filename();
+                prism::CameraImage shown = rendered;
+                if (output.tonemap) shown.image = prism::tone_map(rendered.image, camera.tonemaps[*output.tonemap]);
+                Row row = scene_row;
+                row.image = image_name.string();
+                row.size = std::to_string(shown.image.width) + "x" + std::to_string(shown.image.height);
+                row.seconds = fixed(rendered.seconds, 2);
+                std::optional<Reference> reference = find_reference(job, image_name, scene.cameras.size());
+                // A camera writing several files pairs each with the reference of its exact
+                // name: latlong.exr must not be judged against latlong.png's tone mapping.
+                if (reference && outputs.size() > 1 && !same_name(reference->path, image_name)) reference.reset();
+                if (reference) {
+                    for (std::size_t r = 0; r < job.references.size(); ++r)
+                        if (job.references[r].path == reference->path || same_stem(job.references[r].path, image_name))
+                            reference_used[r] = true;
+                    row = compare_image(arguments, camera, shown, *reference, row);
                 } else {
-                    try {
-                        prism::write_image(output, rendered.image);
-                    } catch (const std::exception& write_error) {
-                        row.status = "ERROR";
-                        row.note += std::string(row.note.empty() ? "" : "; ") + write_error.what();
+                    row.status = "rendered";
+                }
+                if (arguments.output_dir) {
+                    const fs::path written = *arguments.output_dir / job.output_subfolder / image_name;
+                    std::error_code error;
+                    if (reference && fs::equivalent(written, reference->path, error)) {
+                        row.note += std::string(row.note.empty() ? "" : "; ") + "not written over its reference";
+                    } else {
+                        try {
+                            prism::write_image(written, shown.image);
+                        } catch (const std::exception& write_error) {
+                            row.status = "ERROR";
+                            row.note += std::string(row.note.empty() ? "" : "; ") + write_error.what();
+                        }
                     }
                 }
+                if (!unsupported.empty())
+                    row.note += std::string(row.note.empty() ? "" : "; ") + "not rendered yet: " + unsupported;
+                emit(row);
             }
-            if (!unsupported.empty())
-                row.note += std::string(row.note.empty() ? "" : "; ") + "not rendered yet: " + unsupported;
-            emit(row);
         }
         for (std::size_t r = 0; r < job.references.size(); ++r)
             if (!reference_used[r]) {
