@@ -1,6 +1,6 @@
-// Image comparison for the scene suite: PSNR and the share of visibly wrong pixels over 8-bit RGB
-// (what the PNG files hold), and an area-averaging box filter that brings a full-size reference
-// down to the size of a reduced-resolution render.
+// Image comparison for the scene suite and the benchmarks: PSNR, RMSE and the share of visibly
+// wrong pixels over 8-bit RGB (what the PNG files hold), and an area-averaging box filter that
+// brings a full-size reference down to the size of a reduced-resolution render.
 #pragma once
 
 #include <prism/image/image.hpp>
@@ -11,23 +11,40 @@
 #include <cstdlib>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace prism {
 
-// Peak signal-to-noise ratio in dB over every channel value, with 255 as the peak; infinity for
-// identical images, so "equal" never hides behind a large finite number.
-inline double psnr(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b) {
-    if (a.size() != b.size()) throw std::invalid_argument("psnr: the images differ in size");
-    if (a.empty()) throw std::invalid_argument("psnr: empty images");
+namespace detail {
+
+// Mean of the squared differences over every channel value, in 8-bit levels squared.
+inline double mean_square_difference(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b,
+                                     const char* caller) {
+    if (a.size() != b.size()) throw std::invalid_argument(std::string(caller) + ": the images differ in size");
+    if (a.empty()) throw std::invalid_argument(std::string(caller) + ": empty images");
     double sum_of_squares = 0.0;
     for (std::size_t i = 0; i < a.size(); ++i) {
         const double difference = double(a[i]) - double(b[i]);
         sum_of_squares += difference * difference;
     }
-    if (sum_of_squares == 0.0) return std::numeric_limits<double>::infinity();
-    const double mean_square = sum_of_squares / double(a.size());
+    return sum_of_squares / double(a.size());
+}
+
+}  // namespace detail
+
+// Peak signal-to-noise ratio in dB over every channel value, with 255 as the peak; infinity for
+// identical images, so "equal" never hides behind a large finite number.
+inline double psnr(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b) {
+    const double mean_square = detail::mean_square_difference(a, b, "psnr");
+    if (mean_square == 0.0) return std::numeric_limits<double>::infinity();
     return 10.0 * std::log10(255.0 * 255.0 / mean_square);
+}
+
+// Root-mean-square difference over every channel value, in 8-bit levels (0..255): the error PSNR
+// is computed from, on a scale that reads directly and is 0 for identical images.
+inline double rmse(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b) {
+    return std::sqrt(detail::mean_square_difference(a, b, "rmse"));
 }
 
 // Share (0..1) of RGB pixels where any channel differs by more than `levels`: PSNR averages a
