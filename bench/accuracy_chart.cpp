@@ -168,6 +168,7 @@ struct SceneResult {
     std::vector<std::uint8_t> reference;
     double load_seconds = 0;
     std::size_t triangles = 0;
+    int samples = 1;  // per pixel, as the scene's camera declares
 };
 
 prism::scene::Scene load_chart_scene(const ChartScene& chart_scene, const Options& options) {
@@ -196,6 +197,7 @@ SceneResult measure_scene(std::size_t scene_index, const Options& options) {
     result.load_seconds = seconds_since(load_start);
     result.triangles = triangle_count(scene);
     const prism::scene::Camera& camera = scene.cameras.front();
+    result.samples = std::max(1, camera.num_samples);
     const int width = prism::scaled_size(camera.width, options.scale);
     const int height = prism::scaled_size(camera.height, options.scale);
     std::cerr << chart_scene.name << ": " << result.triangles << " triangles, " << width << "x" << height
@@ -521,8 +523,10 @@ void write_tsv(const fs::path& path, const std::vector<SceneResult>& results) {
 std::string markdown_section(const std::vector<SceneResult>& results, const Options& options, double total_seconds,
                              const std::string& start_load, const std::string& date,
                              const std::vector<std::string>& checks) {
+    std::string samples;
+    for (const SceneResult& result : results) samples += (samples.empty() ? "" : ", ") + std::to_string(result.samples);
     std::ostringstream md;
-    md << "Command (from the repository's root; written by it, " << date << "):\n\n```sh\n" << options.command
+    md << "Written by this command, run from the repository's root on " << date << ":\n\n```sh\n" << options.command
        << "\n```\n\n";
     md << "- **Machine:** `nproc` = " << std::thread::hardware_concurrency() << ", CPU `" << cpu_model()
        << "` (/proc/cpuinfo), compiler " << __VERSION__ << ", Release (`-O3 -DNDEBUG`), revision `" << options.revision
@@ -530,10 +534,21 @@ std::string markdown_section(const std::vector<SceneResult>& results, const Opti
     md << "- **Threads:** " << tbb::info::default_concurrency()
        << " (all cores; TBB tiles of 16x16 pixels). Load average before the run: " << start_load
        << "; after: " << load_average() << ".\n";
-    md << "- **Resolution:** each camera's own times `--scale " << options.scale
-       << "`, the scene's own samples per pixel (1 in all five), seed 0 for every variant.\n";
+    md << "- **Scenes** (`../shared/`):";
+    for (const ChartScene& chart_scene : chart_scenes()) {
+        md << "\n  - " << chart_scene.name << ": `" << chart_scene.file << "`";
+        if (chart_scene.subdivision_levels > 0)
+            md << ", largest mesh subdivided " << chart_scene.subdivision_levels << " times (`subdivide_largest_mesh`)";
+        if (chart_scene.offset != prism::scene::Vec3(0.0))
+            md << ", the whole scene (camera and light too) moved by (" << chart_scene.offset.x << ", "
+               << chart_scene.offset.y << ", " << chart_scene.offset.z << ") (`translate`)";
+        md << (&chart_scene == &chart_scenes().back() ? "." : ";");
+    }
+    md << "\n";
+    md << "- **Resolution:** each scene's first camera's, times `--scale " << options.scale
+       << "`; the scene's own samples per pixel (" << samples << "), seed 0 for every variant.\n";
     md << "- **Time:** render only (the BVH build is its own column), wall clock, median of " << options.runs
-       << " runs after one warm-up; the runs are interleaved, every variant once per round in a shuffled order. "
+       << " run(s) after one warm-up; the runs are interleaved, every variant once per round in a shuffled order. "
        << "The program ran " << std::lround(total_seconds) << " s (loading, subdividing, BVH builds and renders; "
        << "compiling not included).\n";
     md << "- **Error:** against the reference (Watertight double, error-bound offsets) rendered from the same "
