@@ -309,7 +309,7 @@ TEST_CASE("2020+ textures: images decoded once, every TextureMap element, refere
     CHECK(bump.image == 0);
     CHECK(bump.decal_mode == DecalMode::bump_normal);
     CHECK(bump.bump_factor == 0.08);
-    CHECK(bump.interpolation == Interpolation::bilinear);  // the default
+    CHECK(bump.interpolation == Interpolation::nearest);  // the course's default
     CHECK(bump.normalizer == 255.0);
     CHECK(!bump.degamma);
     const Texture& perlin = scene.textures[2];

@@ -79,18 +79,26 @@ TEST_CASE_TEMPLATE("MipMap: nearest takes the texel containing (u, v), v = 0 at 
     CHECK(map.nearest({0.25, -0.25}).x == 2);
 }
 
-TEST_CASE_TEMPLATE("MipMap: bilinear blends texel centres at +0.5 and wraps at the borders", Real, float, double) {
+TEST_CASE_TEMPLATE("MipMap: bilinear samples texel i at u W = i, the course's convention, and wraps", Real, float, double) {
     const MipMap<Real> map(grey_image(2, 2, [](int x, int y) { return x + 2 * y; }));
-    CHECK(double(map.bilinear({0.25, 0.25}).x) == doctest::Approx(0.0));  // a texel centre
-    CHECK(double(map.bilinear({0.75, 0.75}).x) == doctest::Approx(3.0));
-    CHECK(double(map.bilinear({0.5, 0.25}).x) == doctest::Approx(0.5));   // between texels 0 and 1
-    CHECK(double(map.bilinear({0.5, 0.5}).x) == doctest::Approx(1.5));    // all four
-    CHECK(double(map.bilinear({0.375, 0.25}).x) == doctest::Approx(0.25));
-    // At u = 0 the left texel's centre is half a texel away and its neighbour across the border
-    // (texel 1 by repeat) the other half: (0 + 1) / 2.
-    CHECK(double(map.bilinear({0.0, 0.25}).x) == doctest::Approx(0.5));
-    CHECK(double(map.bilinear({0.25, 0.0}).x) == doctest::Approx(1.0));  // rows 0 and 1: (0 + 2) / 2
-    CHECK(double(map.bilinear({1.5, 1.5}).x) == doctest::Approx(1.5));
+    CHECK(double(map.bilinear({0.0, 0.0}).x) == doctest::Approx(0.0));   // texel (0, 0) itself
+    CHECK(double(map.bilinear({0.5, 0.0}).x) == doctest::Approx(1.0));   // texel (1, 0)
+    CHECK(double(map.bilinear({0.5, 0.5}).x) == doctest::Approx(3.0));   // texel (1, 1)
+    CHECK(double(map.bilinear({0.25, 0.0}).x) == doctest::Approx(0.5));  // u W = 0.5: (0 + 1) / 2
+    CHECK(double(map.bilinear({0.375, 0.0}).x) == doctest::Approx(0.75));
+    CHECK(double(map.bilinear({0.25, 0.25}).x) == doctest::Approx(1.5));  // all four
+    // Not the texel centres: at u = 0.25, inside texel 0 where nearest reads 0, bilinear is
+    // already half-way to texel 1.
+    CHECK(map.nearest({0.25, 0.0}).x == 0);
+    // The last texel blends with the first across the border (repeat): u W = 1.5.
+    CHECK(double(map.bilinear({0.75, 0.0}).x) == doctest::Approx(0.5));
+    CHECK(double(map.bilinear({0.0, 0.75}).x) == doctest::Approx(1.0));  // rows 1 and 0: (2 + 0) / 2
+    CHECK(double(map.bilinear({-0.25, 0.0}).x) == doctest::Approx(0.5));  // u W = -0.5: texels 1 and 0
+    CHECK(double(map.bilinear({1.5, 1.5}).x) == doctest::Approx(3.0));
+}
+
+TEST_CASE("scene::Texture: a texture without <Interpolation> is looked up nearest (the course's default)") {
+    CHECK(scene::Texture{}.interpolation == scene::Interpolation::nearest);
 }
 
 TEST_CASE_TEMPLATE("MipMap: a 5x3 image's levels are 2x1 and 1x1 area averages", Real, float, double) {
@@ -109,16 +117,17 @@ TEST_CASE_TEMPLATE("MipMap: a 5x3 image's levels are 2x1 and 1x1 area averages",
 
 TEST_CASE_TEMPLATE("MipMap: trilinear blends the bilinear lookups of the two levels around it", Real, float, double) {
     const MipMap<Real> map(grey_image(5, 3, [](int x, int y) { return x + 10 * y; }));
-    const Vec2<Real> uv{0.25, 0.5};
-    // Level 0: x = 0.75 between texels 0 and 1, row 1 exactly: 10.75. Level 1: texel 0: 10.8.
-    CHECK(double(map.trilinear(uv, 0).x) == doctest::Approx(10.75));
-    CHECK(double(map.trilinear(uv, Real(0.5)).x) == doctest::Approx(10.775));
-    CHECK(double(map.trilinear(uv, 1).x) == doctest::Approx(10.8));
-    CHECK(double(map.trilinear(uv, 7).x) == doctest::Approx(12.0));    // beyond the pyramid: 1x1
-    CHECK(double(map.trilinear(uv, -3).x) == doctest::Approx(10.75));  // below 0: the image
-    CHECK(double(map.trilinear(uv, std::nan("")).x) == doctest::Approx(10.75));
-    CHECK(double(map.lookup(uv, 1, scene::Interpolation::bilinear).x) == doctest::Approx(10.75));  // level ignored
-    CHECK(double(map.lookup(uv, 1, scene::Interpolation::trilinear).x) == doctest::Approx(10.8));
+    const Vec2<Real> uv{Real(0.2), Real(1) / Real(3)};
+    // Level 0: (u W, v H) = (1, 1), texel (1, 1): 11. Level 1 (2x1): u W = 0.4 between its
+    // texels 10.8 and 13.2: 10.8 + 0.4 * 2.4 = 11.76 (its single row blends with itself).
+    CHECK(double(map.trilinear(uv, 0).x) == doctest::Approx(11.0));
+    CHECK(double(map.trilinear(uv, Real(0.5)).x) == doctest::Approx(11.38));
+    CHECK(double(map.trilinear(uv, 1).x) == doctest::Approx(11.76));
+    CHECK(double(map.trilinear(uv, 7).x) == doctest::Approx(12.0));  // beyond the pyramid: 1x1
+    CHECK(double(map.trilinear(uv, -3).x) == doctest::Approx(11.0));  // below 0: the image
+    CHECK(double(map.trilinear(uv, std::nan("")).x) == doctest::Approx(11.0));
+    CHECK(double(map.lookup(uv, 1, scene::Interpolation::bilinear).x) == doctest::Approx(11.0));  // level ignored
+    CHECK(double(map.lookup(uv, 1, scene::Interpolation::trilinear).x) == doctest::Approx(11.76));
 }
 
 TEST_CASE_TEMPLATE("MipMap: the level of detail of a ray cone", Real, float, double) {
@@ -401,6 +410,16 @@ TEST_CASE_TEMPLATE("TextureSet: the background texture at a pixel's (u, v)", Rea
     // 0..255 radiance as the PNG shows it: the default Normalizer (255) gives back the stored texel.
     check_vec(*set.background({Real(0.75), Real(0.25)}), Vec3<Real>(10));   // top right
     check_vec(*set.background({Real(0.25), Real(0.75)}), Vec3<Real>(100));  // bottom left
+    {
+        // Bilinear: the pixel centre lands on the texel's sample point (half a texel up and
+        // left), so an image of the camera's size shows each texel on its pixel unblurred.
+        scene.textures[0].interpolation = scene::Interpolation::bilinear;
+        const TextureSet<Real> bilinear(scene);
+        check_vec(*bilinear.background({Real(0.75), Real(0.25)}), Vec3<Real>(10));
+        check_vec(*bilinear.background({Real(0.25), Real(0.75)}), Vec3<Real>(100));
+        check_vec(*bilinear.background({Real(0.5), Real(0.25)}), Vec3<Real>(5));  // between two pixels
+        scene.textures[0].interpolation = scene::Interpolation::nearest;
+    }
     // A background texture is not applied to surfaces.
     const std::vector<std::uint32_t> textures{0};
     Material<Real> material(grey_material());

@@ -169,7 +169,7 @@ struct Texture {
     DecalMode decal_mode = DecalMode::replace_kd;
     // image
     std::size_t image = 0;  // index into Scene::images
-    Interpolation interpolation = Interpolation::bilinear;
+    Interpolation interpolation = Interpolation::nearest;  // the course's default (texture/mipmap.hpp)
     double normalizer = 255.0;  // texel / normalizer is the value in [0, 1] (LDR images)
     bool degamma = false;       // sRGB texels: linearise (pow 2.2) after normalising
     double bump_factor = 1.0;   // scales the height for bump_normal

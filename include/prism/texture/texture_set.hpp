@@ -117,11 +117,20 @@ public:
     // The replace_background texture at a pixel's (u, v) = ((x + 0.5) / width, (y + 0.5) / height)
     // from the top-left corner, in the renderer's radiance units (0..255 is the PNG's range, so
     // an 8-bit image with the default Normalizer shows as stored); nothing without one.
+    // The pixel's centre falls on a texel's sample point: for bilinear lookups, which sample
+    // texel i at u W = i (texture/mipmap.hpp), (u, v) moves half a texel up and left, so an image
+    // of the camera's resolution shows texel (x, y) at pixel (x, y), unblurred, as the course's
+    // galactica_static does (its galaxy.jpg, 1280x720, bilinear: the background matches the
+    // expected image exactly this way, and is blurred by half a texel without the shift).
     std::optional<Vec3<Real>> background(const Vec2<Real>& uv) const {
         if (!background_) return std::nullopt;
         const Entry& texture = textures_[*background_];
         SurfacePoint<Real> point;
         point.uv = uv;
+        if (texture.kind == scene::TextureKind::image && texture.interpolation != scene::Interpolation::nearest) {
+            const MipMap<Real>& image = mipmaps_[texture.mipmap];
+            point.uv -= Vec2<Real>(Real(0.5) / Real(image.width()), Real(0.5) / Real(image.height()));
+        }
         point.position = Vec3<Real>(uv, 0);
         const Vec3<Real> colour = value(texture, point, RayCone<Real>{});
         return texture.kind == scene::TextureKind::image && !texture.high_dynamic_range ? colour * Real(255) : colour;
