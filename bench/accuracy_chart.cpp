@@ -394,7 +394,7 @@ void write_svg(const fs::path& path, const std::vector<SceneResult>& results, do
             shares.push_back(point.share_off);
             rmses.push_back(point.rmse);
         }
-    const double width = 1180, height = 820;
+    const double width = 1180, height = 840;
     std::vector<Panel> panels{
         {90, 105, 470, 420, "pixels off by more than 1/255 (log scale)", log_axis(shares, 0.01),
          [](const Point& p) { return p.share_off; }, true},
@@ -481,14 +481,14 @@ void write_svg(const fs::path& path, const std::vector<SceneResult>& results, do
             << "\"/><text x=\"626\" y=\"" << y << "\" font-size=\"13\">" << escape_xml(chart_scenes()[s].name)
             << "</text>\n";
     }
-    svg << "<text x=\"600\" y=\"" << legend_top + 24 + 24 * double(results.size()) + 8
-        << "\" font-size=\"12\" fill=\"#444\">\"0 (exact)\": no pixel differs from the reference. The reference (dark circle)"
-           "</text>\n";
-    svg << "<text x=\"600\" y=\"" << legend_top + 24 + 24 * double(results.size()) + 44
-        << "\" font-size=\"12\" fill=\"#444\">is at (1, 0) for every scene by construction.</text>\n";
-    svg << "<text x=\"600\" y=\"" << legend_top + 24 + 24 * double(results.size()) + 62
-        << "\" font-size=\"12\" fill=\"#444\">Time: median of " << options.runs
-        << " interleaved runs, process CPU time; BVH build not included.</text>\n";
+    const std::vector<std::string> notes{
+        "\"0 (exact)\": no pixel differs from the reference. The reference",
+        "(dark circle) is at (1, 0) for every scene, by construction.",
+        "Time: median of " + std::to_string(options.runs) + " interleaved runs, process CPU time;",
+        "the BVH build is not included."};
+    for (std::size_t line = 0; line < notes.size(); ++line)
+        svg << "<text x=\"600\" y=\"" << legend_top + 32 + 24 * double(results.size()) + 17 * double(line)
+            << "\" font-size=\"12\" fill=\"#444\">" << escape_xml(notes[line]) << "</text>\n";
     svg << "</svg>\n";
 
     std::ofstream out(path);
