@@ -1,5 +1,6 @@
 // The automatic precision choice: triangles measured against the magnitude of their coordinates
 // decide float, double-precision triangle tests, or double throughout; --precision overrides.
+#include <prism/math/transform.hpp>
 #include <prism/render/render_scene.hpp>
 
 #include <doctest/doctest.h>
@@ -55,5 +56,28 @@ TEST_CASE("--precision overrides the measurement") {
 TEST_CASE("a scene without triangles renders in float") {
     prism::scene::Scene scene;
     scene.spheres.push_back({"1", 0, {0, 0, 0}, 1.0});
+    CHECK(prism::choose_precision(scene, {}).precision == prism::Precision::single);
+}
+
+TEST_CASE("a small sphere far from the origin renders in double throughout") {
+    // radius / (|centre| + radius) = 0.3 / 10^4: about 2^-15, below 2^-12; the double-precision
+    // triangle test would not help a sphere, so it is double throughout, triangles or not.
+    prism::scene::Scene scene = scene_with_triangle(0.5, 1.0);
+    scene.spheres.push_back({"far", 0, {1e4 - 0.3, 0, 0}, 0.3});
+    const auto choice = prism::choose_precision(scene, {});
+    CHECK(choice.precision == prism::Precision::double_all);
+    CHECK(choice.reason.find("sphere") != std::string::npos);
+    // the same sphere near the origin leaves the triangles to decide
+    scene.spheres.back().center = {2, 0, 0};
+    CHECK(prism::choose_precision(scene, {}).precision == prism::Precision::single);
+}
+
+TEST_CASE("a sphere's size is its shortest world axis") {
+    prism::scene::Scene scene;
+    scene.spheres.push_back({"flat", 0, {0, 0, 0}, 1.0});
+    scene.spheres.back().transform = prism::translation({1.0, 0, 0}) * prism::scaling({1.0, 1e-5, 1.0});
+    // radius 1e-5 along y against a magnitude of 1 + 1e-5: 2^-17
+    CHECK(prism::choose_precision(scene, {}).precision == prism::Precision::double_all);
+    scene.spheres.back().transform = glm::dmat4(1.0);
     CHECK(prism::choose_precision(scene, {}).precision == prism::Precision::single);
 }

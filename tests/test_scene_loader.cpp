@@ -1,6 +1,7 @@
 // Scene loading: every course scene of the manifest, each XML scene against its JSON twin,
 // hand-checked scenes (camera, lookAt near plane, transformations, instances), and one test per
 // kind of broken input, each of which must name the file and the element at fault.
+#include "course_manifest.hpp"
 #include "temporary_folder.hpp"
 
 #include <prism/io/load.hpp>
@@ -21,10 +22,6 @@
 #include <string_view>
 #include <vector>
 
-#ifndef PRISM_SHARED_DIR
-#define PRISM_SHARED_DIR "../shared"
-#endif
-
 namespace {
 
 namespace fs = std::filesystem;
@@ -33,31 +30,9 @@ using prism::io::load_scene;
 using prism::scene::Scene;
 using Vec3 = prism::scene::Vec3;
 
-const fs::path course_folder = fs::path(PRISM_SHARED_DIR) / "ceng795";
-
-struct ManifestRow {
-    std::string topic, scene, format, path, unresolved;
-};
-
-std::vector<ManifestRow> read_manifest() {
-    std::ifstream stream(course_folder / "MANIFEST.tsv");
-    std::vector<ManifestRow> rows;
-    std::string line;
-    std::getline(stream, line);  // the header
-    while (std::getline(stream, line)) {
-        if (line.empty()) continue;
-        std::vector<std::string> fields;
-        std::size_t start = 0;
-        for (std::size_t tab = line.find('\t'); tab != std::string::npos; tab = line.find('\t', start)) {
-            fields.push_back(line.substr(start, tab - start));
-            start = tab + 1;
-        }
-        fields.push_back(line.substr(start));
-        fields.resize(7);
-        rows.push_back({fields[0], fields[1], fields[2], fields[3], fields[6]});
-    }
-    return rows;
-}
+using prism_test::course_folder;
+using prism_test::ManifestRow;
+using prism_test::read_manifest;
 
 // Manifest files that cannot load as published. Each must keep failing with its message, so a
 // loader change that silently accepts the fault is noticed.

@@ -69,13 +69,23 @@ struct Choice {
 // their coordinates (4096 float ulps) lose nothing in float with watertight tests; between
 // 2^-16 and 2^-12 the triangle test moves to double (vertices kept in double); below 2^-16 a
 // float ray origin is no longer precise to a fraction of a triangle, so everything is double.
+// Spheres are tested in the renderer's Real, not refined, so a sphere below 2^-12 (a small
+// sphere far from the origin: hw1's spheres_mirror moved 10^4 loses 7% of its pixels in float)
+// makes everything double.
 inline Choice choose_precision(const scene::Scene& scene, const RenderOptions& options) {
     if (options.precision) return {*options.precision, "requested with --precision"};
     const scene::PrecisionFeatures features = scene::measure_precision(scene);
-    if (features.triangles_measured == 0) return {Precision::single, "no triangles: float suffices"};
+    const auto power_of_two = [](double size) { return "2^" + std::to_string(int(std::floor(std::log2(size)))); };
+    if (features.spheres_measured > 0 && features.sphere_relative_size_minimum < 0x1p-12)
+        return {Precision::double_all, "the smallest sphere's radius spans " +
+                                           power_of_two(features.sphere_relative_size_minimum) +
+                                           " of its coordinates, below 2^-12: double throughout"};
+    if (features.triangles_measured == 0)
+        return {Precision::single, features.spheres_measured > 0 ? "no triangles, spheres at least 2^-12: float"
+                                                                 : "no triangles: float suffices"};
     const double size = features.relative_size_percentile_1;
-    const std::string measured = "the smallest triangles (1st percentile) span 2^" +
-                                 std::to_string(int(std::floor(std::log2(size)))) + " of their coordinates";
+    const std::string measured = "the smallest triangles (1st percentile) span " + power_of_two(size) +
+                                 " of their coordinates";
     if (size >= 0x1p-12) return {Precision::single, measured + ", at least 2^-12: float"};
     if (size >= 0x1p-16) return {Precision::double_refine, measured + ", below 2^-12: double-precision triangle tests"};
     return {Precision::double_all, measured + ", below 2^-16: double throughout"};

@@ -1,5 +1,6 @@
 // What a scene needs from a renderer, measured from the plain description: how small its
-// triangles are against the magnitude of their coordinates (which decides float or double),
+// triangles and spheres are against the magnitude of their coordinates (which decides float or
+// double),
 // and which light types it uses (which decides the compiled light set). "Model no more than a
 // scene needs": the dispatcher instantiates the renderer these features call for, and says why.
 #pragma once
@@ -21,7 +22,12 @@ struct PrecisionFeatures {
     // 2^-24 relative, so a triangle with relative size 2^-12 spans about 4096 float ulps.
     double relative_size_percentile_1 = std::numeric_limits<double>::infinity();
     double relative_size_minimum = std::numeric_limits<double>::infinity();
-    double largest_coordinate = 0;  // world space, over every mesh vertex
+    double largest_coordinate = 0;  // world space, over every mesh vertex and sphere
+    // The same for spheres: world radius over the magnitude of the farthest point, the smallest
+    // over every sphere. A sphere far from the origin loses its shape in float just as a
+    // triangle does, and the double-precision triangle test does nothing for it.
+    std::size_t spheres_measured = 0;
+    double sphere_relative_size_minimum = std::numeric_limits<double>::infinity();
 };
 
 namespace detail {
@@ -34,6 +40,13 @@ inline double relative_size(const Vec3& a, const Vec3& b, const Vec3& c, double&
     const double edge = std::min({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
     if (!(edge > 0)) return std::numeric_limits<double>::infinity();
     return magnitude > 0 ? edge / magnitude : std::numeric_limits<double>::infinity();
+}
+
+// A sphere's smallest world radius (the shortest axis of the ellipsoid its transform makes, as
+// the shortest image of the unit axes, which is what the radius shrinks to along that axis).
+inline double world_radius(const Sphere& sphere) {
+    const glm::dmat3 linear(sphere.transform);
+    return sphere.radius * std::min({glm::length(linear[0]), glm::length(linear[1]), glm::length(linear[2])});
 }
 
 }  // namespace detail
@@ -54,6 +67,14 @@ inline PrecisionFeatures measure_precision(const Scene& scene, std::size_t budge
     for (const Placement& placement : placements) total += placement.mesh->triangles.size();
 
     PrecisionFeatures features;
+    for (const Sphere& sphere : scene.spheres) {
+        const double radius = detail::world_radius(sphere);
+        const double magnitude = glm::length(Vec3(sphere.transform * glm::dvec4(sphere.center, 1.0))) + radius;
+        features.largest_coordinate = std::max(features.largest_coordinate, magnitude);
+        if (!(radius > 0) || !(magnitude > 0)) continue;
+        ++features.spheres_measured;
+        features.sphere_relative_size_minimum = std::min(features.sphere_relative_size_minimum, radius / magnitude);
+    }
     if (total == 0) return features;
     const std::size_t stride = std::max<std::size_t>(1, total / budget);
     std::vector<double> sizes;
