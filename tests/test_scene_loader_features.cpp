@@ -2,6 +2,7 @@
 // lights, motion blur, the camera's sampling elements, degamma and roughness. Each inline scene is
 // also loaded as its JSON transliteration (the course's 2025 rules) and must mean the same; each
 // fault must name the file and the element. Last, every hw3, hw4 and hw5 scene of the manifest.
+#include "course_manifest.hpp"
 #include "temporary_folder.hpp"
 
 #include <prism/image/image_io.hpp>
@@ -20,10 +21,6 @@
 #include <string>
 #include <string_view>
 #include <vector>
-
-#ifndef PRISM_SHARED_DIR
-#define PRISM_SHARED_DIR "../shared"
-#endif
 
 namespace {
 
@@ -684,7 +681,7 @@ TEST_CASE("faults in textures, images and the new lights name the file and the e
 
 namespace {
 
-const fs::path course_folder = fs::path(PRISM_SHARED_DIR) / "ceng795";
+using prism_test::course_folder;
 
 // The elements these scenes may still leave unread, and why.
 const std::set<std::string> documented_unsupported = {
@@ -706,26 +703,15 @@ TEST_CASE("every hw3, hw4 and hw5 scene of the manifest loads, leaving nothing u
         MESSAGE("skipped: no " << (course_folder / "MANIFEST.tsv"));
         return;
     }
-    std::ifstream manifest(course_folder / "MANIFEST.tsv");
-    std::string line;
-    std::getline(manifest, line);  // the header
     std::size_t rows = 0, loaded = 0, textured = 0, missing_assets = 0;
-    while (std::getline(manifest, line)) {
-        std::vector<std::string> fields;
-        std::size_t start = 0;
-        for (std::size_t tab = line.find('\t'); tab != std::string::npos; tab = line.find('\t', start)) {
-            fields.push_back(line.substr(start, tab - start));
-            start = tab + 1;
-        }
-        fields.push_back(line.substr(start));
-        fields.resize(7);
-        const std::string& topic = fields[0];
-        const std::string& path = fields[3];
+    for (const prism_test::ManifestRow& row : prism_test::read_manifest()) {
+        const std::string& topic = row.topic;
+        const std::string& path = row.path;
         if (topic != "hw3" && topic != "hw4" && topic != "hw5") continue;
         ++rows;
         INFO(path);
-        if (!fields[6].empty()) {
-            MESSAGE("not loaded, its assets are unresolved (" << fields[6] << "): " << path);
+        if (!row.unresolved.empty()) {
+            MESSAGE("not loaded, its assets are unresolved (" << row.unresolved << "): " << path);
             continue;
         }
         try {
