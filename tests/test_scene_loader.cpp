@@ -594,6 +594,16 @@ TEST_CASE("the type attribute makes mirrors; an untyped Transparency makes glass
     CHECK(near(scene.materials[2].mirror, Vec3(0.5)));
     CHECK(scene.materials[3].type == prism::scene::MaterialType::dielectric);
     CHECK(near(scene.materials[3].transparency, Vec3(0.9)));
+
+    // As 2017-2019 files mean it: the untyped mirror colour makes a mirror; the others keep theirs.
+    prism::io::LoadOptions legacy;
+    legacy.untyped_mirrors_reflect = true;
+    const Scene old = load_scene(folder.path() / "material_types.xml", legacy);
+    REQUIRE(old.materials.size() == 4);
+    CHECK(old.materials[0].type == prism::scene::MaterialType::blinn_phong);
+    CHECK(old.materials[1].type == prism::scene::MaterialType::mirror);
+    CHECK(old.materials[2].type == prism::scene::MaterialType::mirror);
+    CHECK(old.materials[3].type == prism::scene::MaterialType::dielectric);
 }
 
 TEST_CASE("numbers in any course spelling parse; TexCoordData and vertexOffset reach the mesh") {

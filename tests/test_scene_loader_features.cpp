@@ -478,7 +478,8 @@ TEST_CASE("area lights: the 2019+ square around its centre and the 2017-2018 cor
     CHECK(old_form.corner == Vec3(-5.0, 9.95, 5.0));
     CHECK(old_form.edge1 == Vec3(0.0, 0.0, -10.0));
     CHECK(old_form.edge2 == Vec3(10.0, 0.0, 0.0));
-    CHECK(old_form.radiance == Vec3(700000.0));
+    // Its Intensity is the whole 10 x 10 panel's: radiance Intensity / area.
+    CHECK(near(old_form.radiance, Vec3(7000.0)));
 
     // Any normal: two perpendicular edges of length Size, perpendicular to the normal, centred.
     const auto& tilted = scene.area_lights[2];

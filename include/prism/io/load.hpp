@@ -15,12 +15,12 @@
 
 namespace prism::io {
 
-inline scene::Scene load_scene(const std::filesystem::path& path) {
+inline scene::Scene load_scene(const std::filesystem::path& path, const LoadOptions& options = {}) {
     std::string extension = path.extension().string();
     std::transform(extension.begin(), extension.end(), extension.begin(),
                    [](unsigned char c) { return char(std::tolower(c)); });
-    if (extension == ".xml") return interpret_scene(read_xml(path), path);
-    if (extension == ".json") return interpret_scene(read_json(path), path);
+    if (extension == ".xml") return interpret_scene(read_xml(path), path, options);
+    if (extension == ".json") return interpret_scene(read_json(path), path, options);
     throw LoadError(path, "", "unknown scene format \"" + extension + "\": expected a .xml or .json file");
 }
 

@@ -13,7 +13,7 @@
 //     schema's bumpmap="true" texture becomes its DecalMode texture plus a bump_normal one).
 //   - AreaLight: the 2019+ square (centre, Normal, Size) becomes corner + two edges, the course's
 //     orthonormal pair around the normal (read_area_light); the 2017-2018 corner + EdgeVectors
-//     form is taken as written, its Intensity as the radiance.
+//     form is taken as written, its Intensity (the whole panel's) as radiance Intensity / area.
 //   - MotionBlur on Mesh, Triangle, Sphere and MeshInstance (the instance's own, else none);
 //     an instance's textures are its own, else its base mesh's.
 //   - degamma="true" materials get Ambient/Diffuse/SpecularReflectance linearised by pow(c, 2.2).
@@ -54,12 +54,21 @@
 
 namespace prism::io {
 
+// Choices of interpretation that the files themselves cannot settle.
+struct LoadOptions {
+    // A material with no type but a MirrorReflectance: Blinn-Phong only (false: what the
+    // course's images of 2021-2025 files show) or a mirror (true: what 2017-2019 files meant,
+    // when the course's files had no material types; cornellbox_glossy's untyped spheres with
+    // a Roughness are glossy mirrors). No file says which year's rules it follows.
+    bool untyped_mirrors_reflect = false;
+};
+
 namespace detail::scene_loader {
 
 
 class Interpreter : private ElementReader {
 public:
-    explicit Interpreter(const std::filesystem::path& file) : ElementReader(file) {}
+    Interpreter(const std::filesystem::path& file, const LoadOptions& options) : ElementReader(file), options_(options) {}
 
     scene::Scene interpret(const Element& root) {
         if (root.name != "Scene") fail(root, "the root element must be <Scene>, not <" + root.name + ">");
@@ -220,7 +229,10 @@ private:
                 // images of untyped 2021-2025 scenes show no reflections (rt_raven: 17.8 dB
                 // with a mirror, 55.8 dB without). 2017-2019 files give glass as an untyped
                 // Transparency colour, which no later file uses, so that still makes glass.
+                // LoadOptions::untyped_mirrors_reflect reads their mirrors as mirrors too.
                 if (material.transparency != scene::Vec3(0.0)) material.type = scene::MaterialType::dielectric;
+                else if (options_.untyped_mirrors_reflect && material.mirror != scene::Vec3(0.0))
+                    material.type = scene::MaterialType::mirror;
             } else {
                 fail(element, "unknown material type " + in_quotes(*type) + " (expected mirror, conductor or dielectric)");
             }
@@ -509,14 +521,20 @@ private:
             light.corner = position - 0.5 * (light.edge1 + light.edge2);
         }
         const Element* radiance = element.child("Radiance");
-        if (radiance == nullptr) radiance = element.child("Intensity");
-        if (radiance == nullptr) fail(element, "missing <Radiance> (before 2019: <Intensity>)");
-        light.radiance = vector3(*radiance);
+        const Element* intensity = radiance == nullptr ? element.child("Intensity") : nullptr;
+        if (radiance == nullptr && intensity == nullptr) fail(element, "missing <Radiance> (before 2019: <Intensity>)");
         const glm::dmat4 transform = transformation_of(element);
         light.corner = transform_point(transform, light.corner);
         light.edge1 = transform_direction(transform, light.edge1);
         light.edge2 = transform_direction(transform, light.edge2);
-        if (glm::length(glm::cross(light.edge1, light.edge2)) == 0.0) fail(element, "the light's edges span no area");
+        const double area = glm::length(glm::cross(light.edge1, light.edge2));
+        if (area == 0.0) fail(element, "the light's edges span no area");
+        // Before 2019 the panel had an Intensity, the whole panel's, as a point light has one:
+        // each sample lights a point by I |cos theta_l| / d^2 (a 2018 course renderer,
+        // emrebarisc/AdvancedRayTracing), which is radiance I / A. The 2017 glass_plates_area is
+        // glass_plates_point with its point light turned into a 5 x 5 panel of the same
+        // Intensity; read as radiance, such scenes come out 25 to 100 times too bright.
+        light.radiance = radiance != nullptr ? vector3(*radiance) : vector3(*intensity) / area;
         note_unsupported_children(element, {"Position", "Normal", "Size", "Radiance", "EdgeVector1", "EdgeVector2",
                                             "Intensity", "Transformations"});
         return light;
@@ -801,6 +819,7 @@ private:
         for (scene::MeshInstance& instance : instances) scene_.mesh_instances.push_back(std::move(instance));
     }
 
+    LoadOptions options_;
     scene::Scene scene_;
     TextureLoader textures_{*this, scene_};
     std::vector<scene::Vec3> vertices_;
@@ -814,8 +833,9 @@ private:
 }  // namespace detail::scene_loader
 
 // Interprets a scene file's element tree; `file` names the file in messages and locates PLYs.
-inline scene::Scene interpret_scene(const Element& root, const std::filesystem::path& file) {
-    return detail::scene_loader::Interpreter(file).interpret(root);
+inline scene::Scene interpret_scene(const Element& root, const std::filesystem::path& file,
+                                    const LoadOptions& options = {}) {
+    return detail::scene_loader::Interpreter(file, options).interpret(root);
 }
 
 }  // namespace prism::io
