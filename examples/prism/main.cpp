@@ -43,6 +43,10 @@ options:
                        epsilon, unless it is below 64 ulps of the scene's largest coordinate
   --seed N             selects the pixels' random streams (default 0); any thread count gives
                        the same image for the same seed
+  --untyped-mirrors M  a material with no type but a MirrorReflectance: ignore (Blinn-Phong only,
+                       as the course's images of 2021-2025 scenes show; the default) or
+                       reflect (a mirror, as 2017-2019 scene files, written before material
+                       types existed, mean it)
   --cull-backfaces     primary rays ignore triangles facing away from the camera
   --quiet              print nothing but errors
   --help               this text
@@ -55,6 +59,7 @@ struct Arguments {
     std::filesystem::path scene;
     std::filesystem::path output_dir = ".";
     prism::RenderOptions options;
+    prism::io::LoadOptions load;
     bool quiet = false;
 };
 
@@ -74,6 +79,11 @@ Arguments parse_arguments(int argc, char** argv) {
             continue;
         } else if (arg == "--output-dir") {
             arguments.output_dir = std::filesystem::path(value());
+        } else if (arg == "--untyped-mirrors") {
+            const std::string_view mode = value();
+            if (mode == "reflect") arguments.load.untyped_mirrors_reflect = true;
+            else if (mode == "ignore") arguments.load.untyped_mirrors_reflect = false;
+            else command_line.usage_error("--untyped-mirrors must be reflect or ignore");
         } else if (arg == "--cull-backfaces") {
             arguments.options.cull_backfaces = true;
         } else if (arg == "--quiet") {
@@ -97,7 +107,7 @@ int main(int argc, char** argv) {
     std::ostringstream silent;
     std::ostream& log = arguments.quiet ? static_cast<std::ostream&>(silent) : std::cout;
     try {
-        const prism::scene::Scene scene = prism::io::load_scene(arguments.scene);
+        const prism::scene::Scene scene = prism::io::load_scene(arguments.scene, arguments.load);
         if (scene.cameras.empty()) throw prism::io::LoadError(arguments.scene, "<Cameras>", "the scene has no camera");
 
         const std::size_t total_pixels = prism::total_pixels(scene, arguments.options);
