@@ -12,17 +12,7 @@ for argument in "$@"; do
     exec build-chart/bench/prism_accuracy_chart --help
   fi
 done
-bash tools/install-dependencies.sh
-missing=()
-for package in librsvg2-bin fonts-dejavu-core; do
-  dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
-done
-if ((${#missing[@]})); then
-  echo "installing: ${missing[*]}"
-  sudo=""; [[ $(id -u) -ne 0 ]] && sudo="sudo"
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+bash tools/install-dependencies.sh --with-chart
 cmake -S . -B build-chart -DCMAKE_BUILD_TYPE=Release -DPRISM_BUILD_BENCHMARKS=ON -DPRISM_BUILD_TESTS=OFF \
       -DPRISM_BUILD_EXAMPLES=OFF > /dev/null
 cmake --build build-chart -j "$(nproc)" --target prism_accuracy_chart

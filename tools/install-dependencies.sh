@@ -1,9 +1,17 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages prism builds with, if any is missing. Needs root (or sudo).
+# --with-embree adds Embree 3 (the benchmarks' comparison); --with-chart adds what
+# tools/chart.sh needs to turn its SVG into a PNG (rsvg-convert and a font).
 set -euo pipefail
 packages=(build-essential cmake pkg-config libglm-dev libtinyexr-dev libstb-dev nlohmann-json3-dev
           libpugixml-dev libtbb-dev doctest-dev libbenchmark-dev)
-if [[ "${1:-}" == "--with-embree" ]]; then packages+=(libembree-dev); fi
+for option in "$@"; do
+  case "$option" in
+    --with-embree) packages+=(libembree-dev) ;;
+    --with-chart) packages+=(librsvg2-bin fonts-dejavu-core) ;;
+    *) echo "install-dependencies.sh: unknown option $option (expected --with-embree or --with-chart)" >&2; exit 2 ;;
+  esac
+done
 missing=()
 for package in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
