@@ -1,11 +1,16 @@
 // Textures: mip-mapped lookups, Perlin noise, the checkerboard, and each decal mode of
 // TextureSet on hand-built surface points, against values worked out by hand.
+#include <prism/accel/accelerator.hpp>
+#include <prism/geometry/scene_geometry.hpp>
 #include <prism/image/image_io.hpp>
 #include <prism/texture/texture_set.hpp>
 
 #include <doctest/doctest.h>
+#include <glm/gtc/matrix_transform.hpp>
 
+#include <array>
 #include <cmath>
+#include <cstdlib>
 #include <cstdint>
 #include <filesystem>
 #include <vector>
@@ -148,7 +153,7 @@ namespace {
 double reference_noise(double x, double y, double z) {
     const auto& g = PerlinNoise<double>::gradients;
     const auto& p = PerlinNoise<double>::permutation;
-    const auto phi = [&](int n) { return int(p[std::size_t(n & 15)]); };
+    const auto phi = [&](int n) { return int(p[std::size_t(std::abs(n) % 16)]); };
     const int i = int(std::floor(x)), j = int(std::floor(y)), k = int(std::floor(z));
     const double fx = x - i, fy = y - j, fz = z - k;
     const auto fade = [](double t) { return t * t * t * (t * (t * 6 - 15) + 10); };
@@ -186,14 +191,30 @@ TEST_CASE_TEMPLATE("Perlin: the course's form equals Perlin 2002's lerps, is fix
     CHECK(high > 0.5);
 }
 
+TEST_CASE_TEMPLATE("Perlin: the course's permutation and phi(n) = P[|n| mod 16], by hand", Real, float, double) {
+    using Noise = PerlinNoise<Real>;
+    CHECK(Noise::permutation == std::array<std::uint8_t, 16>{4, 10, 11, 15, 14, 5, 13, 1, 6, 9, 3, 7, 8, 2, 0, 12});
+    // On the lattice edge from (0, 0, 0) to (0, 1, 0) only its two ends weigh in, w(0.5) = 1/2 each:
+    // n(0, 0.5, 0) = 1/4 (g_y(0, 0, 0) - g_y(0, 1, 0)).
+    // g(0, 0, 0) = G[phi(0 + phi(0 + phi(0)))] = G[P[P[P[0]]]] = G[P[P[4]]] = G[P[14]] = G[0] = (1, 1, 0);
+    // g(0, 1, 0) = G[phi(0 + phi(1 + 4))] = G[phi(P[5])] = G[P[5]] = G[5] = (-1, 0, 1): 1/4 (1 - 0).
+    CHECK(double(Noise::noise({0, Real(0.5), 0})) == doctest::Approx(0.25));
+    // At k = -1, phi(-1) = P[|-1|] = P[1] = 10 (two's complement, P[15] = 12, would give +0.25):
+    // g(0, 0, -1) = G[phi(phi(10))] = G[phi(P[10] = 3)] = G[P[3]] = G[15] = (0, -1, -1);
+    // g(0, 1, -1) = G[phi(phi(1 + 10))] = G[phi(P[11] = 7)] = G[P[7]] = G[1] = (-1, 1, 0): 1/4 (-1 - 1).
+    CHECK(double(Noise::noise({0, Real(0.5), -1})) == doctest::Approx(-0.5));
+}
+
 TEST_CASE("Perlin: fixed values, the same in every run and build") {
-    // Recorded from the permutation table once: a change of table or formula shows here, and
-    // images made with the texture stay reproducible.
-    CHECK(PerlinNoise<double>::noise({0.5, 0.25, 0.75}) == doctest::Approx(0.028479099274).epsilon(1e-9));
-    CHECK(PerlinNoise<double>::noise({1.3, -0.6, 2.2}) == doctest::Approx(0.135042380212).epsilon(1e-9));
-    CHECK(double(PerlinNoise<float>::noise({1.3f, -0.6f, 2.2f})) == doctest::Approx(0.135042380212).epsilon(1e-4));
-    // The 16-entry permutation repeats every 16 cells.
-    CHECK(PerlinNoise<double>::noise({16.5, 32.25, -47.25}) == doctest::Approx(0.028479099274).epsilon(1e-9));
+    // Computed once by an independent implementation of the course's formula and table: a change
+    // of table or formula shows here, and images made with the texture stay reproducible.
+    CHECK(PerlinNoise<double>::noise({0.5, 0.25, 0.75}) == doctest::Approx(-0.247321128845).epsilon(1e-9));
+    CHECK(PerlinNoise<double>::noise({1.3, -0.6, 2.2}) == doctest::Approx(0.103024041968).epsilon(1e-9));
+    CHECK(double(PerlinNoise<float>::noise({1.3f, -0.6f, 2.2f})) == doctest::Approx(0.103024041968).epsilon(1e-4));
+    CHECK(PerlinNoise<double>::noise({-0.5, 0.25, 0.75}) == doctest::Approx(-0.054866313934).epsilon(1e-9));
+    // The 16-entry permutation repeats every 16 cells (at positive coordinates; |n| mirrors the
+    // lattice at 0 instead).
+    CHECK(PerlinNoise<double>::noise({16.5, 32.25, 48.75}) == doctest::Approx(-0.247321128845).epsilon(1e-9));
 }
 
 TEST_CASE_TEMPLATE("Perlin: octaves add noise at double frequency and half amplitude; conversions", Real, float, double) {
@@ -333,9 +354,10 @@ TEST_CASE_TEMPLATE("TextureSet: replace_normal rotates the normal into the (dpdu
     CHECK(point.shading_normal == Vec3<Real>(0, 0, 1));
 }
 
-TEST_CASE_TEMPLATE("TextureSet: bump_normal tilts the normal away from a rising ramp, by BumpFactor", Real, float, double) {
-    // Heights 0, 0.2, 0.4, 0.6 along u (a 4x1 ramp, Normalizer 255): dh/du = 0.2 per texel = 0.8 per unit u.
-    scene::Scene scene = scene_with_image_texture(grey_image(4, 1, [](int x, int) { return 51 * x; }), scene::DecalMode::bump_normal);
+TEST_CASE_TEMPLATE("TextureSet: bump_normal: heights in the file's units, one texel's difference per unit (u, v)", Real, float, double) {
+    // A 4x1 ramp stored as 0, 1, 2, 3 (of 255): one unit of height per texel, so dh/du = 1
+    // (the course's convention: the neighbour's difference, not divided by the texel's 1/4).
+    scene::Scene scene = scene_with_image_texture(grey_image(4, 1, [](int x, int) { return x; }), scene::DecalMode::bump_normal);
     scene.textures[0].interpolation = scene::Interpolation::bilinear;
     const std::vector<std::uint32_t> textures{0};
     Material<Real> material(grey_material());
@@ -343,30 +365,93 @@ TEST_CASE_TEMPLATE("TextureSet: bump_normal tilts the normal away from a rising 
         const TextureSet<Real> set(scene);
         SurfacePoint<Real> point = flat_point<Real>(textures, {Real(0.375), Real(0.5)});
         set.apply(point, material);
-        check_vec(point.shading_normal, glm::normalize(Vec3<Real>(Real(-0.8), 0, 1)));
+        check_vec(point.shading_normal, glm::normalize(Vec3<Real>(-1, 0, 1)));
         CHECK(double(glm::length(point.shading_normal)) == doctest::Approx(1.0));
+        // Nearest: texel 1 (u W = 1.5) and texel 2: the same difference.
+        scene.textures[0].interpolation = scene::Interpolation::nearest;
+        point = flat_point<Real>(textures, {Real(0.375), Real(0.5)});
+        TextureSet<Real>(scene).apply(point, material);
+        check_vec(point.shading_normal, glm::normalize(Vec3<Real>(-1, 0, 1)));
+        scene.textures[0].interpolation = scene::Interpolation::bilinear;
     }
     {
         scene.textures[0].bump_factor = 0.5;
         const TextureSet<Real> set(scene);
         SurfacePoint<Real> point = flat_point<Real>(textures, {Real(0.375), Real(0.5)});
         set.apply(point, material);
-        check_vec(point.shading_normal, glm::normalize(Vec3<Real>(Real(-0.4), 0, 1)));
+        check_vec(point.shading_normal, glm::normalize(Vec3<Real>(Real(-0.5), 0, 1)));
         // A left-handed (u, v) frame (v down the image, the course's spheres): the same slope
         // in u still tilts away from +u.
         point = flat_point<Real>(textures, {Real(0.375), Real(0.5)});
         point.dpdv = {0, -1, 0};
         set.apply(point, material);
-        check_vec(point.shading_normal, glm::normalize(Vec3<Real>(Real(-0.4), 0, 1)));
+        check_vec(point.shading_normal, glm::normalize(Vec3<Real>(Real(-0.5), 0, 1)));
         // Twice as long a tangent: half the slope per unit length.
         point = flat_point<Real>(textures, {Real(0.375), Real(0.5)});
         point.dpdu = {2, 0, 0};
         set.apply(point, material);
-        check_vec(point.shading_normal, glm::normalize(Vec3<Real>(Real(-0.2), 0, 1)));
+        check_vec(point.shading_normal, glm::normalize(Vec3<Real>(Real(-0.25), 0, 1)));
+        // A mesh scaled by 1/20: heights in its own units, so a unit of height moves the point
+        // by 1/20 and the tilt is 1/20 (bump_mapping_transformed's floor). Its world tangents
+        // are 1/20 long too, as the geometry gives them.
+        point = flat_point<Real>(textures, {Real(0.375), Real(0.5)});
+        point.texture_frame = Mat3<Real>(Real(0.05));
+        point.dpdu = {Real(0.05), 0, 0};
+        point.dpdv = {0, Real(0.05), 0};
+        set.apply(point, material);
+        check_vec(point.shading_normal, glm::normalize(Vec3<Real>(Real(-0.5), 0, 1)));
+        // The same tangents in world units (a sphere's): the full slope per unit length, 20 x 0.5.
+        point = flat_point<Real>(textures, {Real(0.375), Real(0.5)});
+        point.dpdu = {Real(0.05), 0, 0};
+        point.dpdv = {0, Real(0.05), 0};
+        set.apply(point, material);
+        check_vec(point.shading_normal, glm::normalize(Vec3<Real>(-10, 0, 1)));
+    }
+    {
+        // The Normalizer scales the height: 0..127.5 stored is 0..255 in the file's units.
+        scene.textures[0].bump_factor = 1;
+        scene.textures[0].normalizer = 127.5;
+        SurfacePoint<Real> point = flat_point<Real>(textures, {Real(0.375), Real(0.5)});
+        TextureSet<Real>(scene).apply(point, material);
+        check_vec(point.shading_normal, glm::normalize(Vec3<Real>(-2, 0, 1)));
     }
 }
 
-TEST_CASE_TEMPLATE("TextureSet: Perlin colours and bumps at the world position", Real, float, double) {
+TEST_CASE_TEMPLATE("SceneGeometry: textures live in a mesh's object space and in world space on spheres", Real, float, double) {
+    scene::Scene world;
+    world.materials.push_back(grey_material());
+    // A unit square at z = 0 facing +z, scaled by 1/20 and mirrored in x.
+    scene::Mesh square;
+    square.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    square.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    square.triangles = {{0, 1, 2}, {0, 2, 3}};
+    square.transform = glm::scale(glm::dmat4(1.0), glm::dvec3(-0.05, 0.05, 0.05));
+    world.meshes.push_back(square);
+    // A sphere stretched along x, far from the square.
+    scene::Sphere sphere{"stretched", 0, {0, 0, 0}, 1, glm::dmat4(1.0)};
+    sphere.transform = glm::translate(glm::dmat4(1.0), glm::dvec3(10, 0, 0)) * glm::scale(glm::dmat4(1.0), glm::dvec3(2, 1, 1));
+    world.spheres.push_back(sphere);
+    const SceneGeometry<Real, Bvh<Watertight>, false> geometry(world);
+    const auto surface_at = [&](Vec3<Real> origin) {
+        Ray<Real> ray{origin, Vec3<Real>(0, 0, -1), Real(0), infinity<Real>, Real(0)};
+        Hit<Real> hit;
+        REQUIRE(geometry.intersect(ray, hit));
+        return geometry.surface(ray, hit);
+    };
+    // The square, hit at world (-0.02, 0.03): object (0.4, 0.6, 0), and its transformation's
+    // linear part as the frame.
+    const SurfacePoint<Real> on_square = surface_at({Real(-0.02), Real(0.03), 1});
+    check_vec(on_square.texture_position, Vec3<Real>(Real(0.4), Real(0.6), 0));
+    CHECK(double(on_square.texture_frame[0][0]) == doctest::Approx(-0.05));
+    CHECK(double(on_square.texture_frame[1][1]) == doctest::Approx(0.05));
+    CHECK(double(on_square.texture_frame[2][2]) == doctest::Approx(0.05));
+    // The sphere's top, world (10, 0, 1): the world position and the identity.
+    const SurfacePoint<Real> on_sphere = surface_at({10, 0, 5});
+    check_vec(on_sphere.texture_position, Vec3<Real>(10, 0, 1));
+    CHECK(on_sphere.texture_frame == Mat3<Real>(1));
+}
+
+TEST_CASE_TEMPLATE("TextureSet: Perlin colours and bumps in the texture space", Real, float, double) {
     scene::Scene scene;
     scene::Texture texture;
     texture.kind = scene::TextureKind::perlin;
@@ -380,11 +465,12 @@ TEST_CASE_TEMPLATE("TextureSet: Perlin colours and bumps at the world position",
     const std::vector<std::uint32_t> colour{0}, bump{1};
     Material<Real> material(grey_material());
     SurfacePoint<Real> point = flat_point<Real>(colour);
-    point.position = {Real(0.3), Real(0.45), Real(0.1)};
-    point.local_position = {7, 7, 7};  // ignored
+    const Vec3<Real> p{Real(0.3), Real(0.45), Real(0.1)};
+    point.texture_position = p;
+    point.position = point.local_position = {7, 7, 7};  // ignored: textures read the texture space
     set.apply(point, material);
-    const Real expected = (PerlinNoise<Real>::noise(point.position * Real(3)) + 1) / 2;
-    check_vec(material.diffuse, Vec3<Real>(expected), 1e-4);
+    const auto height = [&](Vec3<Real> q) { return (PerlinNoise<Real>::noise(q * Real(3)) + 1) / 2; };
+    check_vec(material.diffuse, Vec3<Real>(height(p)), 1e-4);
 
     point.textures = bump;
     set.apply(point, material);
@@ -393,11 +479,18 @@ TEST_CASE_TEMPLATE("TextureSet: Perlin colours and bumps at the world position",
     CHECK(n.z > 0);
     // N' = N - 0.5 (grad h)_tangent: the tilt is minus half the noise's slope along x and y.
     const Real h = Real(1e-3);
-    const auto height = [&](Vec3<Real> p) { return (PerlinNoise<Real>::noise(p * Real(3)) + 1) / 2; };
-    const Real slope_x = (height(point.position + Vec3<Real>(h, 0, 0)) - height(point.position - Vec3<Real>(h, 0, 0))) / (2 * h);
-    const Real slope_y = (height(point.position + Vec3<Real>(0, h, 0)) - height(point.position - Vec3<Real>(0, h, 0))) / (2 * h);
+    const Real slope_x = (height(p + Vec3<Real>(h, 0, 0)) - height(p - Vec3<Real>(h, 0, 0))) / (2 * h);
+    const Real slope_y = (height(p + Vec3<Real>(0, h, 0)) - height(p - Vec3<Real>(0, h, 0))) / (2 * h);
     CHECK(double(n.x / n.z) == doctest::Approx(double(-Real(0.5) * slope_x)).epsilon(0.02));
     CHECK(double(n.y / n.z) == doctest::Approx(double(-Real(0.5) * slope_y)).epsilon(0.02));
+
+    // A mesh turned 90 degrees about z and scaled by 2: the bump is made in its object space and
+    // turned with it ((x, y) -> (-y, x)); the uniform scale changes nothing (heights scale too).
+    point = flat_point<Real>(bump);
+    point.texture_position = p;
+    point.texture_frame = Mat3<Real>(Vec3<Real>(0, 2, 0), Vec3<Real>(-2, 0, 0), Vec3<Real>(0, 0, 2));  // columns
+    set.apply(point, material);
+    check_vec(point.shading_normal, Vec3<Real>(-n.y, n.x, n.z), 1e-4);
 }
 
 TEST_CASE_TEMPLATE("TextureSet: the background texture at a pixel's (u, v)", Real, float, double) {

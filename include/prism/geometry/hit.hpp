@@ -29,7 +29,14 @@ struct SurfacePoint {
     // normal and bump maps. Zero where the surface has no (u, v): meshes without texture
     // coordinates, planes.
     Vec3<Real> dpdu{0}, dpdv{0};
-    Vec3<Real> local_position{0};  // in the object's own space: where solid textures are evaluated
+    // The space solid textures (Perlin noise, checkerboards) are evaluated in and bump heights are
+    // measured in: a mesh's object space, world space on spheres and planes, as the course does
+    // (texture/texture_set.hpp has the evidence). texture_position is the point in that space;
+    // texture_frame carries its directions to world space (the linear part of a mesh's
+    // transformation, the identity elsewhere and for points built by hand).
+    Vec3<Real> texture_position{0};
+    Mat3<Real> texture_frame{1};
+    Vec3<Real> local_position{0};  // in the object's own space (a sphere's (u, v) come from it)
     std::uint32_t material = 0;
     std::span<const std::uint32_t> textures;  // the object's textures (indices into Scene::textures)
     // What SceneGeometry::spawn_origin needs to leave the surface by its error bound: the hit

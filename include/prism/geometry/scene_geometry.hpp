@@ -150,6 +150,7 @@ public:
         if (hit.object >= instances_.size()) {
             const std::size_t p = hit.object - instances_.size();
             point.geometric_normal = point.shading_normal = point.object_normal = planes_[p].normal;
+            point.texture_position = point.position;
             const PointWithError<Real> exact = planes_[p].hit_point(point.position);
             point.object_point = exact.point;
             point.object_error = exact.error;
@@ -178,6 +179,13 @@ public:
         point.object_point = exact.point;
         point.object_error = exact.error;
         point.object_normal = geometric_normal;
+        // Textures on a mesh live in its object space, on a sphere in world space (hit.hpp).
+        if (instance.kind == Kind::mesh) {
+            point.texture_position = point.local_position;
+            if (instance.transformed) point.texture_frame = instance.object_to_world_linear;
+        } else {
+            point.texture_position = point.position;
+        }
         if (instance.transformed) {
             geometric_normal = glm::normalize(instance.normal_to_world * geometric_normal);
             shading_normal = glm::normalize(instance.normal_to_world * shading_normal);

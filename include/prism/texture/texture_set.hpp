@@ -10,22 +10,35 @@
 //   and VeachAjar's picture (Normalizer 1, texels 0..255) show the image at its stored
 //   brightness with no highlight or shadow, next to lit objects. The integrator receives it as
 //   the return value of apply().
-// - Perlin and checkerboard values are taken at the world-space position: cube_perlin's
-//   reference shows the noise's seams on the planes y = 0 and z = 0 of the world, mid-way
-//   across faces whose object-space coordinates run 0..1; the ellipsoids of ellipsoids_texture
-//   (spheres scaled 5x along z) carry round, unstretched noise.
+// - Perlin and checkerboard values are taken in the texture space of SurfacePoint
+//   (geometry/hit.hpp): a mesh's object space, world space on spheres and planes. With the
+//   course's noise table (texture/perlin.hpp), cube_perlin (two transformed cube meshes) renders
+//   at 80.2 dB in object space and 21.0 dB in world space, while ellipsoids_texture (spheres
+//   scaled 5x along z, round noise) renders at 51.4 dB in world space and 25.6 dB in object
+//   space. The checkerboard follows the same rule unmeasured (no course image shows one).
 //
 // Normal and bump maps perturb the current shading normal N (the interpolated one on smooth
 // meshes; every course scene with maps is flat or a sphere, where the two agree) in the frame
 //   T = dpdu made orthogonal to N, B = dpdv made orthogonal to N and T,
-// so a mirrored (u, v) parametrisation mirrors the frame with it. Evidence, from shading the
-// course's sphere scenes (no shadows) with this file and comparing with their expected images:
-// - a normal map's green runs along dpdv, i.e. down the image: sphere_normal gives 32.1 dB this
-//   way, 26.8 dB with green flipped (up the image);
-// - bump heights differentiated per unit (u, v) with BumpFactor as given: sphere_nobump_justbump
-//   shows the same relief along the coasts (29.1 dB; scaling the slope by 0.4-0.5 gave 31.0 dB,
-//   within what the missing shadows and the lights' terminator explain; to re-measure with the
-//   full integrator).
+// so a mirrored (u, v) parametrisation mirrors the frame with it. Evidence, from the course's
+// expected images:
+// - a normal map's green runs along dpdv, i.e. down the image: shading sphere_normal without
+//   shadows gave 32.1 dB this way, 26.8 dB with green flipped (up the image); the full
+//   integrator with nearest lookups (its map names no Interpolation) gives 55.0 dB;
+// - image bump heights are in the 8-bit file's units (BumpFactor x the texel's mean of R, G, B
+//   x 255 / Normalizer), and the difference between neighbouring texels is taken as the
+//   derivative per unit of u or v (not divided by the texel's 1/W). Measured with the full
+//   integrator: galactica_static 52.0 dB, sphere_nobump_bump 50.2, sphere_nobump_justbump 48.7;
+//   the same heights differentiated per unit (u, v) (times W, H) gave 38.4, 33.5 and 30.8 dB:
+//   255 / W = 0.25 along the earth's u (1024 texels), 255 / H = 0.5 along its v and rap01's
+//   (512), the factors a per-axis fit found (0.25, 0.5: 50.2 and 48.6 dB on the spheres).
+// - heights are measured in the same texture space: a mesh's own units, world units on spheres.
+//   bump_mapping_transformed (a plane scaled by 0.05, a sphere scaled by (-2, 1, 1)): 45.5 dB;
+//   both in world units 21.0 dB (the plane's bumps 20 times too steep); both in object units
+//   34.6 dB (30.0 dB inside the sphere's outline, 41.5 dB with the sphere in world units).
+// - Perlin bumps differentiate the noise 10^-3 apart in that space, whatever NoiseScale:
+//   cube_perlin_bump 75.2 dB, sphere_perlin_bump 50.0 dB; 10^-3 / NoiseScale apart (10^-4 on the
+//   cube) gives 39.1 and 50.0 dB, 10^-2 / NoiseScale 75.2 and 40.8 dB.
 #pragma once
 
 #include <prism/geometry/hit.hpp>
@@ -120,8 +133,9 @@ public:
     // The pixel's centre falls on a texel's sample point: for bilinear lookups, which sample
     // texel i at u W = i (texture/mipmap.hpp), (u, v) moves half a texel up and left, so an image
     // of the camera's resolution shows texel (x, y) at pixel (x, y), unblurred, as the course's
-    // galactica_static does (its galaxy.jpg, 1280x720, bilinear: the background matches the
-    // expected image exactly this way, and is blurred by half a texel without the shift).
+    // galactica_static does (its galaxy.jpg, 1280x720, bilinear: the background, 61% of the
+    // image, is within one level of the expected image this way, 98% of it identical, and is
+    // blurred by half a texel without the shift).
     std::optional<Vec3<Real>> background(const Vec2<Real>& uv) const {
         if (!background_) return std::nullopt;
         const Entry& texture = textures_[*background_];
@@ -174,8 +188,8 @@ private:
     Vec3<Real> value(const Entry& texture, const SurfacePoint<Real>& point, const RayCone<Real>& cone) const {
         switch (texture.kind) {
             case scene::TextureKind::image: return texel(texture, point.uv, level_of_detail(texture, point, cone));
-            case scene::TextureKind::perlin: return Vec3<Real>(noise(texture, point.position));
-            case scene::TextureKind::checkerboard: return texture.checkerboard.colour(point.position);
+            case scene::TextureKind::perlin: return Vec3<Real>(noise(texture, point.texture_position));
+            case scene::TextureKind::checkerboard: return texture.checkerboard.colour(point.texture_position);
         }
         return Vec3<Real>(0);
     }
@@ -216,31 +230,36 @@ private:
         set_shading_normal(point, c.x * tangent + c.y * bitangent + c.z * point.shading_normal);
     }
 
-    // Bump map (Blinn 1978, as the course gives it): the surface is displaced along N by a height
-    // h, so its tangents become dpdu + (dh/du) N and dpdv + (dh/dv) N, and the new normal is
-    // their cross product, turned to N's side:
-    //   N' ~ N + ((dh/du) (N x dpdv) + (dh/dv) (dpdu x N)) / |dpdu x dpdv|
+    // Bump map (Blinn 1978, as the course gives it): the surface is displaced along its normal by
+    // a height h, so its tangents become dpdu + (dh/du) d and dpdv + (dh/dv) d, and the new normal
+    // is their cross product, turned to N's side:
+    //   N' ~ N + ((dh/du) (d x dpdv) + (dh/dv) (dpdu x d)) / |dpdu x dpdv|
     // (for a right-handed (dpdu, dpdv, N); a left-handed frame flips the second term's sign).
-    // Images: h = BumpFactor x the normalised texel's mean of R, G, B, differentiated by forward
-    // differences one texel apart (dh/du = (h(u + 1/W) - h(u)) W).
-    // Perlin: h = BumpFactor x the converted noise at the world position; the surface gradient is
-    // the noise gradient (forward differences in world space) minus its part along N:
-    //   N' = N - BumpFactor (grad h - (grad h . N) N).
+    // d is where a unit of height moves the point in world space: N itself in world space, the
+    // object's unit normal carried by the mesh's transformation in a mesh's object space
+    // (SurfacePoint::texture_frame), so a scaled mesh scales its bumps with it.
+    // Images: h = BumpFactor x the mean of R, G, B in the file's 0..255 units (x 255 / Normalizer),
+    // and dh/du is the forward difference one texel apart, h(u + 1/W) - h(u), taken per unit u as
+    // the course does (see the header).
+    // Perlin: h = BumpFactor x the converted noise at the texture-space position; its gradient by
+    // forward differences 10^-3 apart in that space, less its part along the normal n there:
+    //   n' = n - BumpFactor (grad h - (grad h . n) n), carried to world space as normals are.
     void bump_normal(const Entry& texture, SurfacePoint<Real>& point, const RayCone<Real>& cone) const {
         const Vec3<Real> n = point.shading_normal;
-        if (texture.kind == scene::TextureKind::perlin || texture.kind == scene::TextureKind::checkerboard) {
-            if (texture.kind == scene::TextureKind::checkerboard) return;  // piecewise constant: no slope
-            // A step small against a noise cell (1 / NoiseScale) and large against the position's
-            // rounding error.
-            const Real step = Real(1e-3) / std::max(texture.noise_scale, Real(1e-6)) *
-                              std::max(Real(1), glm::length(point.position) * Real(1e-2));
-            const Real h = noise(texture, point.position);
-            const Vec3<Real> gradient =
-                Vec3<Real>(noise(texture, point.position + Vec3<Real>(step, 0, 0)) - h,
-                           noise(texture, point.position + Vec3<Real>(0, step, 0)) - h,
-                           noise(texture, point.position + Vec3<Real>(0, 0, step)) - h) / step;
-            const Vec3<Real> surface_gradient = gradient - glm::dot(gradient, n) * n;
-            set_shading_normal(point, n - texture.bump_factor * surface_gradient);
+        const Mat3<Real>& frame = point.texture_frame;
+        // The unit normal in texture space: normals map by the inverse transpose, so back by the transpose.
+        const Vec3<Real> texture_normal = glm::normalize(glm::transpose(frame) * n);
+        if (texture.kind == scene::TextureKind::checkerboard) return;  // piecewise constant: no slope
+        if (texture.kind == scene::TextureKind::perlin) {
+            const Real step = Real(1e-3);
+            const Vec3<Real>& p = point.texture_position;
+            const Real h = noise(texture, p);
+            const Vec3<Real> gradient = Vec3<Real>(noise(texture, p + Vec3<Real>(step, 0, 0)) - h,
+                                                   noise(texture, p + Vec3<Real>(0, step, 0)) - h,
+                                                   noise(texture, p + Vec3<Real>(0, 0, step)) - h) / step;
+            const Vec3<Real> surface_gradient = gradient - glm::dot(gradient, texture_normal) * texture_normal;
+            const Vec3<Real> bumped = texture_normal - texture.bump_factor * surface_gradient;
+            set_shading_normal(point, glm::transpose(glm::inverse(frame)) * bumped);
             return;
         }
         const Vec3<Real> across = glm::cross(point.dpdu, point.dpdv);
@@ -249,17 +268,17 @@ private:
         const MipMap<Real>& image = mipmaps_[texture.mipmap];
         const Real level = level_of_detail(texture, point, cone);
         const auto height = [&](const Vec2<Real>& uv) {
-            const Vec3<Real> c = image.lookup(uv, level, texture.interpolation) * texture.texel_scale;
+            const Vec3<Real> c = image.lookup(uv, level, texture.interpolation) * (texture.texel_scale * Real(255));
             return texture.bump_factor * (c.x + c.y + c.z) / Real(3);
         };
-        const Real du = Real(1) / Real(image.width()), dv = Real(1) / Real(image.height());
         const Real h = height(point.uv);
-        const Real dh_du = (height(point.uv + Vec2<Real>(du, 0)) - h) / du;
-        const Real dh_dv = (height(point.uv + Vec2<Real>(0, dv)) - h) / dv;
+        const Real dh_du = height(point.uv + Vec2<Real>(Real(1) / Real(image.width()), 0)) - h;
+        const Real dh_dv = height(point.uv + Vec2<Real>(0, Real(1) / Real(image.height()))) - h;
+        const Vec3<Real> d = frame * texture_normal;
         // The (u, v) frame may be left-handed (dpdu x dpdv = -N on the course's spheres, whose v
         // runs downwards): orient by it, so the normal tilts away from the slope either way.
         const Real side = glm::dot(across, n) < 0 ? Real(-1) : Real(1);
-        const Vec3<Real> tilt = (dh_du * glm::cross(n, point.dpdv) + dh_dv * glm::cross(point.dpdu, n)) * side / area;
+        const Vec3<Real> tilt = (dh_du * glm::cross(d, point.dpdv) + dh_dv * glm::cross(point.dpdu, d)) * side / area;
         set_shading_normal(point, n + tilt);
     }
 
