@@ -493,6 +493,30 @@ TEST_CASE_TEMPLATE("TextureSet: Perlin colours and bumps in the texture space", 
     check_vec(point.shading_normal, Vec3<Real>(-n.y, n.x, n.z), 1e-4);
 }
 
+TEST_CASE_TEMPLATE("TextureSet: Perlin bumps step 10^-3 in texture space, whatever NoiseScale", Real, float, double) {
+    // NoiseScale 1000: a step of 10^-3 spans a whole noise cell, from (0, 0.5, 0) (noise 1/4, by
+    // hand in the test of the course's permutation) to (1, 0.5, 0): 1/4 (g_y(1, 0, 0) - g_y(1, 1, 0))
+    // = 1/4 (1 - 1) = 0; (0, 1.5, 0): 1/4 (g_y(0, 1, 0) - g_y(0, 2, 0)) = 1/4 (0 + 1) = 1/4;
+    // (0, 0.5, 1): 1/4 (g_y(0, 0, 1) - g_y(0, 1, 1)) = 1/4 (-1 - 1) = -1/2.
+    // Linear heights (n + 1) / 2: 0.625 at the point, 0.5, 0.625, 0.25 a step along x, y, z; the
+    // gradient (-125, 0, -375), its part along the surface (-125, 0, 0), times BumpFactor 10^-3.
+    scene::Scene scene;
+    scene::Texture texture;
+    texture.kind = scene::TextureKind::perlin;
+    texture.decal_mode = scene::DecalMode::bump_normal;
+    texture.noise_scale = 1000;
+    texture.noise_conversion = scene::NoiseConversion::linear;
+    texture.bump_factor = 1e-3;
+    scene.textures.push_back(texture);
+    const TextureSet<Real> set(scene);
+    const std::vector<std::uint32_t> bump{0};
+    Material<Real> material(grey_material());
+    SurfacePoint<Real> point = flat_point<Real>(bump);
+    point.texture_position = {0, Real(0.0005), 0};
+    set.apply(point, material);
+    check_vec(point.shading_normal, glm::normalize(Vec3<Real>(Real(0.125), 0, 1)), 1e-4);
+}
+
 TEST_CASE_TEMPLATE("TextureSet: the background texture at a pixel's (u, v)", Real, float, double) {
     CHECK(!TextureSet<Real>(scene::Scene{}).background({Real(0.5), Real(0.5)}));
     scene::Scene scene = scene_with_image_texture(grey_image(2, 2, [](int x, int y) { return 10 * x + 100 * y; }),
