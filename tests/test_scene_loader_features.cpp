@@ -8,6 +8,7 @@
 #include <prism/image/image_io.hpp>
 #include <prism/io/load.hpp>
 #include <prism/io/xml_reader.hpp>
+#include <prism/light/area_light.hpp>
 
 #include <doctest/doctest.h>
 #include <nlohmann/json.hpp>
@@ -492,6 +493,37 @@ TEST_CASE("area lights: the 2019+ square around its centre and the 2017-2018 cor
 
     CHECK(near(scene.area_lights[3].corner + 0.5 * (scene.area_lights[3].edge1 + scene.area_lights[3].edge2),
                {10.0, 0.0, 0.0}));
+}
+
+// The pre-2019 panel's Intensity is the whole panel's: a small panel lights the point straight
+// below it as a point light of that Intensity would (the 2017 glass_plates_area/_point pair).
+TEST_CASE_TEMPLATE("a small pre-2019 AreaLight lights like a point light of its Intensity", Real, float, double) {
+    SceneFolder scenes;
+    Parts parts;
+    parts.lights = R"(
+        <AreaLight id="1">
+            <Position>-0.005 10 0.005</Position>
+            <EdgeVector1>0 0 -0.01</EdgeVector1>
+            <EdgeVector2>0.01 0 0</EdgeVector2>
+            <Intensity>1000 1000 1000</Intensity>
+        </AreaLight>
+        <AreaLight id="2">
+            <Position>0 10 0</Position>
+            <Normal>0 -1 0</Normal>
+            <Size>0.01</Size>
+            <Radiance>1000 1000 1000</Radiance>
+        </AreaLight>)";
+    const Scene scene = load_both(scenes, scenes.write("small_panels.xml", parts));
+    const auto lights = prism::AreaLight<Real>::from_scene(scene);
+    REQUIRE(lights.size() == 2);
+    const prism::ShadingFrame<Real> below{prism::Vec3<Real>(0), prism::Vec3<Real>(0, 1, 0)};
+    for (const prism::Vec2<Real> u : {prism::Vec2<Real>(Real(0.5)), prism::Vec2<Real>(0, 0), prism::Vec2<Real>(1, 1)}) {
+        // I / d^2 = 1000 / 100; the panel is 10^-3 of the distance wide, so cos and d move it by
+        // less than 1e-6.
+        CHECK(double(lights[0].sample(below, u).radiance.r) == doctest::Approx(10.0).epsilon(1e-5));
+        // The 2019+ Radiance is per unit area: L A / d^2 = 1000 * 1e-4 / 100.
+        CHECK(double(lights[1].sample(below, u).radiance.r) == doctest::Approx(1e-3).epsilon(1e-5));
+    }
 }
 
 TEST_CASE("SphericalDirectionalLight: image, layout and sampler (cosine by default)") {
