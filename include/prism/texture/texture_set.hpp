@@ -245,11 +245,11 @@ private:
     // forward differences 10^-3 apart in that space, less its part along the normal n there:
     //   n' = n - BumpFactor (grad h - (grad h . n) n), carried to world space as normals are.
     void bump_normal(const Entry& texture, SurfacePoint<Real>& point, const RayCone<Real>& cone) const {
+        if (texture.kind == scene::TextureKind::checkerboard) return;  // piecewise constant: no slope
         const Vec3<Real> n = point.shading_normal;
         const Mat3<Real>& frame = point.texture_frame;
         // The unit normal in texture space: normals map by the inverse transpose, so back by the transpose.
         const Vec3<Real> texture_normal = glm::normalize(glm::transpose(frame) * n);
-        if (texture.kind == scene::TextureKind::checkerboard) return;  // piecewise constant: no slope
         if (texture.kind == scene::TextureKind::perlin) {
             const Real step = Real(1e-3);
             const Vec3<Real>& p = point.texture_position;
