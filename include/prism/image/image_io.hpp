@@ -3,6 +3,7 @@
 // in their system libraries (libstb, libtinyexr), so no *_IMPLEMENTATION macro is defined here.
 #pragma once
 
+#include <prism/image/decoder_guard.hpp>
 #include <prism/image/image.hpp>
 #include <prism/io/limits.hpp>
 #include <prism/io/load_error.hpp>
@@ -275,6 +276,10 @@ inline Image decode_image(std::string_view bytes, const std::filesystem::path& p
     const bool is_ldr = extension == ".png" || extension == ".jpg" || extension == ".jpeg" || extension == ".bmp" ||
                         extension == ".tga" || extension == ".ppm" || extension == ".pgm";
     if (!is_hdr && !is_ldr) throw io::LoadError(path, "", "unsupported image format '" + extension + "'");
+    if (!detail::has_signature_of(bytes, extension))
+        throw io::LoadError(path, "", "the file's content is not the " + extension.substr(1) + " image its name says");
+    if ((extension == ".jpg" || extension == ".jpeg") && !detail::jpeg_huffman_tables_fit(bytes))
+        throw io::LoadError(path, "", "corrupt JPEG: a Huffman table of more than 256 codes");
     // stb takes an int length.
     if (bytes.size() > std::size_t(std::numeric_limits<int>::max()))
         throw io::LoadError(path, "", "the file is larger than 2 GiB");
