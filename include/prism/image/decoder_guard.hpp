@@ -4,11 +4,13 @@
 // the format its extension names (every one of the course's 156 image files is). And that build
 // has a JPEG bug found by fuzzing prism (tests/data/fuzz/image/jpeg_huffman_table_overflow.jpg):
 // a DHT segment whose 16 code counts add up past 256 overflows the Huffman table's arrays in
-// stbi__build_huffman (later stb_image releases refuse such a table), so those are refused here.
+// stbi__build_huffman (later stb_image releases refuse such a table), so those are refused here;
+// so are PNM headers whose numbers overflow stb's int, and 16-bit PNMs.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <string_view>
 
@@ -67,9 +69,10 @@ inline bool jpeg_huffman_tables_fit(std::string_view bytes) {
         }
         std::size_t table = i + 4;
         long remaining = long(length) - 2;
-        while (remaining > 0 && table + 17 <= bytes.size()) {
+        // stb reads zeros past the end of the file, so counts cut off by it count as read.
+        while (remaining > 0 && table < bytes.size()) {
             std::size_t codes = 0;
-            for (std::size_t k = 1; k <= 16; ++k) codes += byte(table + k);
+            for (std::size_t k = 1; k <= 16 && table + k < bytes.size(); ++k) codes += byte(table + k);
             if (codes > 256) return false;
             table += 17 + codes;
             remaining -= long(17 + codes);
@@ -77,6 +80,36 @@ inline bool jpeg_huffman_tables_fit(std::string_view bytes) {
         i = table;
     }
     return true;
+}
+
+// False when a PNM header (P5 or P6) holds a number past INT_MAX, or a maximum value past 255.
+// stb_image 2.27 reads the numbers into an int with no overflow check (signed overflow), and its
+// 16-bit PNM path reads past the buffer it allocated (both found by fuzzing:
+// tests/data/fuzz/image/pnm_header_number_overflow.ppm, pnm_16_bit_overflow.ppm); the course has
+// no PNM image at all. The header is read as stb reads it: whitespace and `#` comments, then
+// width, height and maximum value; a byte past the end reads as 0, and the last byte of the file
+// ends a number without joining it.
+inline bool pnm_header_fits(std::string_view bytes) {
+    std::size_t position = 2;  // past P5 or P6
+    const auto at_end = [&] { return position >= bytes.size(); };
+    const auto next = [&]() -> char { return at_end() ? '\0' : bytes[position++]; };
+    const auto is_space = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\v' || c == '\f' || c == '\r'; };
+    char c = next();
+    std::int64_t value = 0;
+    for (int number = 0; number < 3; ++number) {
+        for (;;) {
+            while (!at_end() && is_space(c)) c = next();
+            if (at_end() || c != '#') break;
+            while (!at_end() && c != '\n' && c != '\r') c = next();
+        }
+        value = 0;
+        while (!at_end() && c >= '0' && c <= '9') {
+            value = value * 10 + (c - '0');
+            if (value > std::numeric_limits<int>::max()) return false;
+            c = next();
+        }
+    }
+    return value <= 255;  // the maximum value, read last
 }
 
 }  // namespace prism::detail

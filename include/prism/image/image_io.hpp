@@ -280,6 +280,8 @@ inline Image decode_image(std::string_view bytes, const std::filesystem::path& p
         throw io::LoadError(path, "", "the file's content is not the " + extension.substr(1) + " image its name says");
     if ((extension == ".jpg" || extension == ".jpeg") && !detail::jpeg_huffman_tables_fit(bytes))
         throw io::LoadError(path, "", "corrupt JPEG: a Huffman table of more than 256 codes");
+    if ((extension == ".ppm" || extension == ".pgm") && !detail::pnm_header_fits(bytes))
+        throw io::LoadError(path, "", "unsupported PNM header: a number past 2147483647 or 16-bit samples");
     // stb takes an int length.
     if (bytes.size() > std::size_t(std::numeric_limits<int>::max()))
         throw io::LoadError(path, "", "the file is larger than 2 GiB");
