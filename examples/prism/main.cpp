@@ -47,7 +47,10 @@ options:
                        as the course's images of 2021-2025 scenes show; the default) or
                        reflect (a mirror, as 2017-2019 scene files, written before material
                        types existed, mean it)
-  --cull-backfaces     primary rays ignore triangles facing away from the camera
+  --cull-backfaces     camera rays ignore every triangle and plane facing away from them
+  --no-cull-backfaces  camera rays see every surface from both sides. Default (neither): the
+                       course's rule, camera rays ignore back-facing triangles of flat-shaded
+                       meshes and see smooth-shaded meshes, spheres and planes from both sides
   --quiet              print nothing but errors
   --help               this text
 
@@ -84,8 +87,6 @@ Arguments parse_arguments(int argc, char** argv) {
             if (mode == "reflect") arguments.load.untyped_mirrors_reflect = true;
             else if (mode == "ignore") arguments.load.untyped_mirrors_reflect = false;
             else command_line.usage_error("--untyped-mirrors must be reflect or ignore");
-        } else if (arg == "--cull-backfaces") {
-            arguments.options.cull_backfaces = true;
         } else if (arg == "--quiet") {
             arguments.quiet = true;
         } else if (!arg.empty() && arg[0] == '-') {
