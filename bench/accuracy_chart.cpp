@@ -192,7 +192,8 @@ prism::scene::Scene load_chart_scene(const ChartScene& chart_scene, const Option
     if (chart_scene.offset != prism::scene::Vec3(0.0)) prism::scene::translate(scene, chart_scene.offset);
     // The variants are compiled with point lights alone and no per-ray features, as every hw1
     // and hw2 scene renders: a scene needing more would be refused by the renderer anyway.
-    const std::string needs = prism::complete_renderer_reason(scene);
+    const std::string needs = prism::scene::measure_needs(scene).beyond(
+        prism::Config<float, prism::Bvh<prism::Watertight>, prism::PointLightSet, prism::no_features>::meets);
     if (!needs.empty()) fail(chart_scene.name + ": the scene needs " + needs + ", and the chart's renderers have point lights only");
     if (scene.cameras.empty()) fail(chart_scene.name + ": the scene has no camera");
     return scene;

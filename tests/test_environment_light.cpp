@@ -467,7 +467,7 @@ TEST_CASE("EnvironmentLight and EnvironmentBackground from a scene") {
     scene::Scene description;
     description.images.push_back({"sky.exr", filled(8, 4, glm::vec3(2.0f)), true});
     description.environment_lights.push_back({"1", 0, Layout::latlong, Sampling::importance, {1.0, 0.5, 0.25}});
-    CHECK(prism::EnvironmentLight<float>::count_in(description) == 1);
+    CHECK(prism::scene::light_kinds(description) == prism::scene::bit(prism::EnvironmentLight<float>::kind));
     const auto lights = prism::EnvironmentLight<double>::from_scene(description);
     REQUIRE(lights.size() == 1);
     CHECK(lights[0].background({0, 0, -1}) == Vec3<double>(2.0, 1.0, 0.5));  // the scale applies
@@ -481,7 +481,8 @@ TEST_CASE("EnvironmentLight and EnvironmentBackground from a scene") {
     // In a light set beside other types, as a renderer's Config would hold it.
     const prism::LightSet<double, prism::PointLight, prism::EnvironmentLight> set(description);
     CHECK(set.size() == 1);
-    CHECK(prism::Lights<prism::PointLight, prism::EnvironmentLight>::count_in(description) == 1);
+    CHECK(prism::Lights<prism::PointLight, prism::EnvironmentLight>::kinds ==
+          (prism::scene::bit(prism::scene::LightKind::point) | prism::scene::bit(prism::scene::LightKind::environment)));
     int visited = 0;
     set.for_each([&](const auto& light) {
         const auto sample = light.sample({Vec3<double>(0), Vec3<double>(0, 1, 0)}, Vec2<double>(0.25, 0.5));

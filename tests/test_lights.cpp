@@ -73,7 +73,7 @@ TEST_CASE_TEMPLATE("DirectionalLight: towards the light, infinitely far, no fall
     world.directional_lights.push_back({"sun", {1, -0.8, -1}, {200, 150, 100}});
     const auto lights = prism::DirectionalLight<Real>::from_scene(world);
     REQUIRE(lights.size() == 1);
-    CHECK(prism::DirectionalLight<Real>::count_in(world) == 1);
+    CHECK(prism::scene::light_kinds(world) == prism::scene::bit(prism::DirectionalLight<Real>::kind));
     const glm::dvec3 towards = -glm::normalize(glm::dvec3(1, -0.8, -1));
     for (const auto& point : {prism::Vec3<Real>(0), prism::Vec3<Real>(1000, -5, 3)}) {
         const prism::LightSample<Real> sample = lights[0].sample({point});
@@ -205,7 +205,7 @@ TEST_CASE("render_scene: a light set without the scene's light type refuses the 
     CHECK_THROWS_WITH_AS(
         (prism::detail::render_with<prism::Config<float, prism::Bvh<prism::Watertight>, prism::PointLightSet>>(
             world, prism::RenderOptions{}, log, ignore)),
-        doctest::Contains("can render only 0"), std::invalid_argument);
+        doctest::Contains("the scene needs spot lights, which this renderer was compiled without"), std::invalid_argument);
     // The dispatcher picks the complete renderer for it, and says why.
     const auto images = prism::render_scene(world, prism::RenderOptions{}, log);
     CHECK(images.size() == 1);

@@ -5,6 +5,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/install-dependencies.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release > /dev/null
+# Every option the tests need is set here, not inherited: the build folder is shared with
+# tools/render-default.sh, and a cache left by another command must not turn the tests off.
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPRISM_BUILD_EXAMPLES=ON -DPRISM_BUILD_TESTS=ON > /dev/null
 cmake --build build -j "$(nproc)"
-ctest --test-dir build --output-on-failure -j "$(nproc)" "$@"
+# --no-tests=error: a run that finds no test fails, instead of passing without testing.
+ctest --test-dir build --output-on-failure --no-tests=error -j "$(nproc)" "$@"

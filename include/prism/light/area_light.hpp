@@ -20,7 +20,7 @@ struct AreaLight {
     Real area = 1;
     Vec3<Real> radiance{0};
 
-    static std::size_t count_in(const scene::Scene& scene) { return scene.area_lights.size(); }
+    static constexpr scene::LightKind kind = scene::LightKind::area;
 
     static std::vector<AreaLight> from_scene(const scene::Scene& scene) {
         std::vector<AreaLight> lights;

@@ -13,7 +13,7 @@ struct DirectionalLight {
     Vec3<Real> to_light{0, 1, 0};  // unit: the opposite of the file's Direction, the way light travels
     Vec3<Real> radiance{0};
 
-    static std::size_t count_in(const scene::Scene& scene) { return scene.directional_lights.size(); }
+    static constexpr scene::LightKind kind = scene::LightKind::directional;
 
     static std::vector<DirectionalLight> from_scene(const scene::Scene& scene) {
         std::vector<DirectionalLight> lights;

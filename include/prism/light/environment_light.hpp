@@ -81,7 +81,7 @@ public:
             distribution_ = std::make_shared<const PiecewiseConstant2D<Real>>(image_distribution(map_));
     }
 
-    static std::size_t count_in(const scene::Scene& scene) { return scene.environment_lights.size(); }
+    static constexpr scene::LightKind kind = scene::LightKind::environment;
 
     // One light per SphericalDirectionalLight; each copies its image once (shared by copies of
     // the light) and builds its sampling distribution once.

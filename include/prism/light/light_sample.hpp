@@ -7,7 +7,7 @@
 #pragma once
 
 #include <prism/math/vector.hpp>
-#include <prism/scene/scene.hpp>
+#include <prism/scene/needs.hpp>
 
 #include <concepts>
 #include <vector>
@@ -36,7 +36,7 @@ concept Light = Scalar<Real> && requires(const L& light, const ShadingFrame<Real
                                          const scene::Scene& scene) {
     { light.sample(at, u) } -> std::same_as<LightSample<Real>>;
     { L::from_scene(scene) } -> std::same_as<std::vector<L>>;
-    { L::count_in(scene) } -> std::convertible_to<std::size_t>;
+    { L::kind } -> std::convertible_to<scene::LightKind>;
 };
 
 }  // namespace prism

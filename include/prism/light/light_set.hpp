@@ -55,11 +55,9 @@ struct Lights {
     template <template <class> class Type>
     static constexpr bool contains = (std::is_same_v<Type<float>, LightTypes<float>> || ...);
 
-    // How many of the scene's lights this set can represent; a dispatcher compares it with the
-    // scene's total so that no light is silently dropped.
-    static std::size_t count_in(const scene::Scene& scene) {
-        return (std::size_t(0) + ... + LightTypes<double>::count_in(scene));
-    }
+    // The light kinds this set can render; a Config covers a scene only if it has all of the
+    // scene's, so that no light is silently dropped.
+    static constexpr scene::LightKinds kinds = (scene::LightKinds(0) | ... | scene::bit(LightTypes<float>::kind));
 };
 
 }  // namespace prism

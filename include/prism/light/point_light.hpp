@@ -12,7 +12,7 @@ struct PointLight {
     Vec3<Real> position{0};
     Vec3<Real> intensity{0};
 
-    static std::size_t count_in(const scene::Scene& scene) { return scene.point_lights.size(); }
+    static constexpr scene::LightKind kind = scene::LightKind::point;
 
     static std::vector<PointLight> from_scene(const scene::Scene& scene) {
         std::vector<PointLight> lights;

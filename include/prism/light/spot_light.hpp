@@ -23,7 +23,7 @@ struct SpotLight {
     Real cos_half_coverage = 1;
     Real cos_half_falloff = 1;
 
-    static std::size_t count_in(const scene::Scene& scene) { return scene.spot_lights.size(); }
+    static constexpr scene::LightKind kind = scene::LightKind::spot;
 
     static SpotLight from_description(const scene::SpotLight& light) {
         // Cosines in double: for the course's narrow cones (coverage 10, falloff 8 degrees) they

@@ -1,13 +1,18 @@
 // A renderer's compile-time configuration: scalar type, acceleration policy (index and triangle
-// intersector), light types, and the shading features that cost work on every ray.
-// `Renderer<Config<float, Bvh<Watertight>, Lights<PointLight>>>` is a type that contains exactly
-// the code those choices need: without `Features::textures` no hit looks up a texture, without
-// `Features::motion_blur` no ray is moved in time.
+// intersector), light types, the shading features that cost work on every ray, and the
+// integrator. `Renderer<Config<float, Bvh<Watertight>, Lights<PointLight>>>` is a type that
+// contains exactly the code those choices need: without `Features::textures` no hit looks up a
+// texture, without `Features::motion_blur` no ray is moved in time. `covers(needs)` states
+// which scenes a Config can render (scene/needs.hpp), so a dispatcher picks among shipped
+// Configs without knowing their parts.
 #pragma once
 
 #include <prism/accel/accelerator.hpp>
 #include <prism/light/light_set.hpp>
 #include <prism/light/point_light.hpp>
+#include <prism/render/integrator.hpp>
+#include <prism/render/whitted_integrator.hpp>
+#include <prism/scene/needs.hpp>
 
 namespace prism {
 
@@ -20,13 +25,23 @@ struct Features {
 };
 
 template <Scalar RealT, class AccelerationT = Bvh<Watertight>, class LightTypesT = Lights<PointLight>,
-          Features FeaturesV = Features{}>
-    requires AccelerationPolicy<AccelerationT, RealT>
+          Features FeaturesV = Features{}, class IntegratorT = Whitted>
+    requires AccelerationPolicy<AccelerationT, RealT> && IntegratorPolicy<IntegratorT>
 struct Config {
     using Real = RealT;
     using Acceleration = AccelerationT;
     using LightTypes = LightTypesT;
+    using IntegratorPolicy = IntegratorT;
     static constexpr Features features = FeaturesV;
+
+    // What this configuration renders, stated as the needs it meets: every light kind of its set
+    // and each per-ray feature it was compiled with. Precision is not a need but a choice
+    // (render_scene).
+    static constexpr scene::Needs meets{LightTypes::kinds, features.textures, features.motion_blur};
+
+    static constexpr bool covers(const scene::Needs& needs) {
+        return needs.within(meets) && IntegratorT::covers(needs);
+    }
 };
 
 }  // namespace prism

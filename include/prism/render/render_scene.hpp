@@ -12,6 +12,7 @@
 #include <prism/light/spot_light.hpp>
 #include <prism/render/renderer.hpp>
 #include <prism/scene/features.hpp>
+#include <prism/scene/needs.hpp>
 #include <prism/scene/scene.hpp>
 
 #include <tbb/global_control.h>
@@ -72,9 +73,8 @@ struct Choice {
 // Spheres are tested in the renderer's Real, not refined, so a sphere below 2^-12 (a small
 // sphere far from the origin: hw1's spheres_mirror moved 10^4 loses 7% of its pixels in float)
 // makes everything double.
-inline Choice choose_precision(const scene::Scene& scene, const RenderOptions& options) {
+inline Choice choose_precision(const scene::PrecisionFeatures& features, const RenderOptions& options) {
     if (options.precision) return {*options.precision, "requested with --precision"};
-    const scene::PrecisionFeatures features = scene::measure_precision(scene);
     const auto power_of_two = [](double size) { return "2^" + std::to_string(int(std::floor(std::log2(size)))); };
     if (features.spheres_measured > 0 && features.sphere_relative_size_minimum < 0x1p-12)
         return {Precision::double_all, "the smallest sphere's radius spans " +
@@ -91,45 +91,44 @@ inline Choice choose_precision(const scene::Scene& scene, const RenderOptions& o
     return {Precision::double_all, measured + ", below 2^-16: double throughout"};
 }
 
-// The two renderers a scene can get in each precision: the fitted one, with point lights alone
-// and no per-ray features (every hw1 and hw2 scene), or the complete one, with every light type,
+// The same, measuring the scene.
+inline Choice choose_precision(const scene::Scene& scene, const RenderOptions& options) {
+    return choose_precision(scene::measure_precision(scene), options);
+}
+
+// The renderers a scene can get in each precision: the fitted one, with point lights alone and
+// no per-ray features (every hw1 and hw2 scene), or the complete one, with every light type,
 // textures and motion blur. Two, not one per combination, to keep the compiled renderers few
-// (each costs about 20 s of compile time on two cores); bench/ measures what the fitted one
-// saves.
+// (each costs about 10 s of compile time on two cores); bench/ measures what the fitted one
+// saves. A light type, feature or integrator is added to the shipped list below, and the
+// dispatcher takes the first Config of a precision's list that covers the scene.
 using PointLightSet = Lights<PointLight>;
 using AllLightSet = Lights<PointLight, DirectionalLight, SpotLight, AreaLight, EnvironmentLight>;
 inline constexpr Features no_features{};
 inline constexpr Features all_features{.textures = true, .motion_blur = true};
 
-// Every light the scene describes, of any type. A light type added to scene::Scene must be
-// counted here, so that a renderer whose light set lacks it refuses the scene instead of
-// leaving the light out.
-inline std::size_t scene_light_count(const scene::Scene& scene) {
-    return scene.point_lights.size() + scene.directional_lights.size() + scene.spot_lights.size() +
-           scene.area_lights.size() + scene.environment_lights.size();
-}
+// What each precision builds: its scalar type and its acceleration policy.
+template <Precision P> struct PrecisionPolicy;
+template <> struct PrecisionPolicy<Precision::single> {
+    using Real = float;
+    using Acceleration = Bvh<Watertight>;
+};
+template <> struct PrecisionPolicy<Precision::double_refine> {
+    using Real = float;
+    using Acceleration = Bvh<DoubleRefine>;
+};
+template <> struct PrecisionPolicy<Precision::double_all> {
+    using Real = double;
+    using Acceleration = Bvh<Watertight>;
+};
 
-// Whether the scene needs more than the fitted renderer: other lights than point lights,
-// textures, or moving objects. Returns what it needs, for the log; empty when nothing.
-inline std::string complete_renderer_reason(const scene::Scene& scene) {
-    std::string reason;
-    const auto add = [&](bool needed, const char* what) {
-        if (!needed) return;
-        reason += reason.empty() ? "" : ", ";
-        reason += what;
-    };
-    add(!scene.directional_lights.empty(), "directional lights");
-    add(!scene.spot_lights.empty(), "spot lights");
-    add(!scene.area_lights.empty(), "area lights");
-    add(!scene.environment_lights.empty(), "environment lights");
-    add(!scene.textures.empty(), "textures");
-    const auto moving = [](const auto& objects) {
-        return std::any_of(objects.begin(), objects.end(),
-                           [](const auto& object) { return object.motion != glm::dvec3(0.0); });
-    };
-    add(moving(scene.meshes) || moving(scene.spheres) || moving(scene.mesh_instances), "motion blur");
-    return reason;
-}
+template <class... Configs> struct ConfigList {};
+
+// The Configs render_scene compiles for a precision, the most specialised first.
+template <Precision P, class Real = typename PrecisionPolicy<P>::Real,
+          class Acceleration = typename PrecisionPolicy<P>::Acceleration>
+using ShippedConfigs = ConfigList<Config<Real, Acceleration, PointLightSet, no_features, Whitted>,
+                                  Config<Real, Acceleration, AllLightSet, all_features, Whitted>>;
 
 // The image size a camera renders at under RenderOptions::resolution_scale (at least 1 pixel).
 inline int scaled_size(int size, double scale) { return std::max(1, int(std::lround(size * scale))); }
@@ -149,13 +148,13 @@ inline std::size_t total_pixels(const scene::Scene& scene, const RenderOptions& 
 // rays leave by their error bounds instead. The course's images are this project's accuracy
 // reference and were rendered with the epsilon: it decides shadows at grazing angles (bunny:
 // 102 dB with it, 36 dB with error bounds, 0.14% of pixels at shadow terminators differ).
-inline RayOffset choose_ray_offset(const scene::Scene& scene, Precision precision, const RenderOptions& options,
-                                   std::string& reason) {
+inline RayOffset choose_ray_offset(const scene::Scene& scene, const scene::PrecisionFeatures& measured,
+                                   Precision precision, const RenderOptions& options, std::string& reason) {
     if (options.ray_offset) {
         reason = "requested with --ray-offset";
         return *options.ray_offset;
     }
-    const double largest = scene::measure_precision(scene).largest_coordinate;
+    const double largest = measured.largest_coordinate;
     const double unit = precision == Precision::double_all ? 0x1p-52 : 0x1p-23;
     const double ulps = scene.shadow_ray_epsilon / (unit * std::max(largest, 1e-300));
     if (largest > 0 && ulps < 64) {
@@ -172,10 +171,6 @@ namespace detail {
 template <class C>
 std::vector<CameraImage> render_with(const scene::Scene& scene, const RenderOptions& options, std::ostream& log,
                                      const std::function<void(std::size_t camera, int pixels)>& on_tile) {
-    if (C::LightTypes::count_in(scene) != scene_light_count(scene))
-        throw std::invalid_argument("the scene has " + std::to_string(scene_light_count(scene)) +
-                                    " lights, of which this renderer's light set can render only " +
-                                    std::to_string(C::LightTypes::count_in(scene)));
     using Clock = std::chrono::steady_clock;
     const auto build_start = Clock::now();
     const Renderer<C> renderer(scene, RendererSettings{options.backface_culling, *options.ray_offset, options.seed});
@@ -196,12 +191,16 @@ std::vector<CameraImage> render_with(const scene::Scene& scene, const RenderOpti
     return images;
 }
 
-template <Scalar Real, class Acceleration>
-std::vector<CameraImage> render_fitted(const scene::Scene& scene, const RenderOptions& options, std::ostream& log,
-                                       const std::function<void(std::size_t camera, int pixels)>& on_tile) {
-    if (!complete_renderer_reason(scene).empty())
-        return render_with<Config<Real, Acceleration, AllLightSet, all_features>>(scene, options, log, on_tile);
-    return render_with<Config<Real, Acceleration, PointLightSet, no_features>>(scene, options, log, on_tile);
+// Renders with the first Config of the list that covers the scene's needs.
+template <class... Configs>
+std::vector<CameraImage> render_first_covering(ConfigList<Configs...>, const scene::Needs& needs,
+                                               const scene::Scene& scene, const RenderOptions& options,
+                                               std::ostream& log,
+                                               const std::function<void(std::size_t camera, int pixels)>& on_tile) {
+    std::optional<std::vector<CameraImage>> images;
+    ((Configs::covers(needs) && (images = render_with<Configs>(scene, options, log, on_tile), true)) || ...);
+    if (!images) throw std::invalid_argument("no renderer compiled into prism covers this scene");
+    return std::move(*images);
 }
 
 }  // namespace detail
@@ -220,24 +219,28 @@ inline std::vector<CameraImage> render_scene(
     }
     const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
     tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
-    const Choice choice = choose_precision(scene, options);
+    const scene::PrecisionFeatures measured = scene::measure_precision(scene);
+    const Choice choice = choose_precision(measured, options);
     std::string offset_reason;
     RenderOptions chosen = options;
-    chosen.ray_offset = choose_ray_offset(scene, choice.precision, options, offset_reason);
-    const std::string complete = complete_renderer_reason(scene);
+    chosen.ray_offset = choose_ray_offset(scene, measured, choice.precision, options, offset_reason);
+    const scene::Needs needs = scene::measure_needs(scene);
+    const std::string beyond = needs.beyond(Config<float, Bvh<Watertight>, PointLightSet, no_features>::meets);
     log << "configuration: " << describe(choice.precision) << " (" << choice.reason << "); "
-        << (complete.empty() ? "point lights only, no textures or motion blur"
-                             : "all light types, textures and motion blur (the scene has " + complete + ")")
+        << (beyond.empty() ? "point lights only, no textures or motion blur"
+                           : "all light types, textures and motion blur (the scene has " + beyond + ")")
         << "; rays leave surfaces by "
         << (*chosen.ray_offset == RayOffset::error_bound ? "their error bounds" : "the ShadowRayEpsilon") << " ("
         << offset_reason << ")\n";
     switch (choice.precision) {
         case Precision::single:
-            return detail::render_fitted<float, Bvh<Watertight>>(scene, chosen, log, on_tile);
+            return detail::render_first_covering(ShippedConfigs<Precision::single>{}, needs, scene, chosen, log, on_tile);
         case Precision::double_refine:
-            return detail::render_fitted<float, Bvh<DoubleRefine>>(scene, chosen, log, on_tile);
+            return detail::render_first_covering(ShippedConfigs<Precision::double_refine>{}, needs, scene, chosen, log,
+                                                 on_tile);
         case Precision::double_all:
-            return detail::render_fitted<double, Bvh<Watertight>>(scene, chosen, log, on_tile);
+            return detail::render_first_covering(ShippedConfigs<Precision::double_all>{}, needs, scene, chosen, log,
+                                                 on_tile);
     }
     throw std::logic_error("unknown precision");
 }

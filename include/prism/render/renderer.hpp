@@ -11,7 +11,6 @@
 #include <prism/image/image.hpp>
 #include <prism/light/environment_light.hpp>
 #include <prism/render/config.hpp>
-#include <prism/render/whitted_integrator.hpp>
 #include <prism/texture/texture_set.hpp>
 
 #include <tbb/blocked_range2d.h>
@@ -41,7 +40,8 @@ public:
     using TexturesT = std::conditional_t<features.textures, TextureSet<Real>, NoTextures<Real>>;
     static constexpr bool environment_lights = C::LightTypes::template contains<EnvironmentLight>;
     using EnvironmentT = std::conditional_t<environment_lights, EnvironmentBackground<Real>, NoEnvironment<Real>>;
-    using Integrator = WhittedIntegrator<Real, Geometry, LightSetT, TexturesT, EnvironmentT>;
+    using Integrator = typename C::IntegratorPolicy::template Type<Real, Geometry, LightSetT, TexturesT, EnvironmentT>;
+    static_assert(prism::Integrator<Integrator, Real>);
 
     static constexpr int tile_size = 16;
 
@@ -108,22 +108,14 @@ private:
         return glm::vec3(sum / weights);
     }
 
-    // A renderer compiled without a feature refuses a scene that needs it, rather than
-    // rendering it wrong.
+    // A renderer compiled without a light kind, a feature or an integrator the scene needs
+    // refuses the scene, rather than rendering it wrong.
     static const scene::Scene& check_features(const scene::Scene& scene) {
-        if constexpr (!features.motion_blur) {
-            const auto moving = [](const auto& objects) {
-                for (const auto& object : objects)
-                    if (object.motion != glm::dvec3(0.0)) return true;
-                return false;
-            };
-            if (moving(scene.meshes) || moving(scene.spheres) || moving(scene.mesh_instances))
-                throw std::invalid_argument("the scene has moving objects (MotionBlur), and this renderer was "
-                                            "compiled without motion blur");
-        }
-        if constexpr (!features.textures) {
-            if (!scene.textures.empty())
-                throw std::invalid_argument("the scene has textures, and this renderer was compiled without them");
+        const scene::Needs needs = scene::measure_needs(scene);
+        if (!C::covers(needs)) {
+            std::string missing = needs.beyond(C::meets);
+            throw std::invalid_argument("the scene needs " + (missing.empty() ? "another integrator" : missing) +
+                                        ", which this renderer was compiled without");
         }
         return scene;
     }

@@ -11,6 +11,7 @@
 #include <prism/geometry/hit.hpp>
 #include <prism/material/fresnel.hpp>
 #include <prism/material/material.hpp>
+#include <prism/render/integrator.hpp>
 #include <prism/sampling/random.hpp>
 #include <prism/texture/mipmap.hpp>
 
@@ -246,6 +247,14 @@ private:
     Vec3<Real> background_;
     IntegratorSettings settings_;
     Real epsilon_;
+};
+
+// The Config policy that renders with the course's recursive ray tracer.
+struct Whitted {
+    template <Scalar Real, class Geometry, class LightSetT, class Textures, class Environment>
+    using Type = WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment>;
+
+    static constexpr bool covers(const scene::Needs&) { return true; }
 };
 
 }  // namespace prism
