@@ -55,7 +55,10 @@ options:
                        as the course's images of 2021-2025 scenes show; the default) or
                        reflect (a mirror, as 2017-2019 scene files, written before material
                        types existed, mean it)
-  --cull-backfaces     primary rays ignore triangles facing away from the camera
+  --cull-backfaces     camera rays ignore every triangle and plane facing away from them
+  --no-cull-backfaces  camera rays see every surface from both sides. Default (neither): the
+                       course's rule, camera rays ignore back-facing triangles of flat-shaded
+                       meshes and see smooth-shaded meshes, spheres and planes from both sides
   --max-recursion-depth N
                        the largest MaxRecursionDepth a scene may ask for (default 64; at most
                        512, the depth the renderer's stack is known to hold)
@@ -106,8 +109,6 @@ Arguments parse_arguments(int argc, char** argv) {
                 command_line.usage_error("--max-recursion-depth must be between 0 and " +
                                          std::to_string(prism::io::stack_safe_recursion_depth));
             arguments.load.limits.max_recursion_depth = depth;
-        } else if (arg == "--cull-backfaces") {
-            arguments.options.cull_backfaces = true;
         } else if (arg == "--quiet") {
             arguments.quiet = true;
         } else if (!arg.empty() && arg[0] == '-') {
