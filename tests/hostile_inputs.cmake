@@ -41,6 +41,8 @@ list(APPEND PRISM_BAD_INPUTS
   "vertex_data_not_triples.xml|vertex_data_not_triples.xml|VertexData"
   "vertex_data_binary_missing.xml|vertex_data_binary_missing.xml|VertexData"
   "vertex_data_binary_truncated.xml|vertex_data_binary_truncated.xml|VertexData"
+  "vertex_data_binary_device.xml|/dev/zero: vertex data: not a regular file|VertexData"
+  "ply_device.xml|/dev/zero: not a regular file|Faces"
   "sphere_negative_radius.xml|sphere_negative_radius.xml|Radius"
   "sphere_unknown_center.xml|sphere_unknown_center.xml|Center"
   "plane_zero_normal.xml|plane_zero_normal.xml|Normal"

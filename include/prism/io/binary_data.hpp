@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <system_error>
 #include <vector>
 
 namespace prism::io {
@@ -22,6 +23,9 @@ namespace detail {
 template <class Value>
 std::vector<Value> read_binary_records(const std::filesystem::path& path, int width, const std::string& element) {
     static_assert(std::endian::native == std::endian::little, "binary data files are little-endian");
+    // Only a regular file: a scene naming /dev/zero or a pipe must not read without end.
+    std::error_code error;
+    if (!std::filesystem::is_regular_file(path, error)) throw LoadError(path, element, "not a regular file");
     std::ifstream stream(path, std::ios::binary);
     if (!stream) throw LoadError(path, element, "cannot open the binary data file");
     const std::vector<char> bytes((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());

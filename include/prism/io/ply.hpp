@@ -549,6 +549,8 @@ inline std::string read_file(const std::filesystem::path& path) {
     std::error_code error;
     if (!std::filesystem::exists(path, error)) throw LoadError(path, "", "file does not exist");
     if (std::filesystem::is_directory(path, error)) throw LoadError(path, "", "is a directory, not a file");
+    // A device or a pipe (/dev/zero, /dev/stdin) could be read without end.
+    if (!std::filesystem::is_regular_file(path, error)) throw LoadError(path, "", "not a regular file");
     std::ifstream stream(path, std::ios::binary);
     if (!stream) throw LoadError(path, "", "cannot open the file for reading");
     stream.seekg(0, std::ios::end);
