@@ -70,6 +70,8 @@ options:
   --ray-offset M       scene-epsilon | error-bound: how rays leave surfaces (default: as
                        prism chooses from the scene)
   --seed N             selects the pixels' random streams (default 0)
+  --accelerator A      prism (the default) or embree (Embree 3 finds the hits; only when built
+                       with libembree-dev)
   --verbose            print the renderer's log (configuration, build times) on stderr
   --help               this text
 
