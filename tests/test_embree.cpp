@@ -197,7 +197,7 @@ TEST_CASE("--accelerator embree renders every hw1 and hw2 course scene as prism'
 TEST_CASE("--accelerator embree culls back faces as prism's own accelerator does") {
     scene::Scene world = mixed_scene();
     prism::RenderOptions options;
-    options.cull_backfaces = true;
+    options.backface_culling = prism::BackfaceCulling::all;
     std::ostringstream log;
     const auto own = prism::render_scene(world, options, log);
     options.accelerator = prism::AcceleratorChoice::embree;
@@ -205,7 +205,7 @@ TEST_CASE("--accelerator embree culls back faces as prism's own accelerator does
     const auto own_bytes = prism::to_8bit(own[0].image);
     CHECK(prism::share_off_by_more_than(own_bytes, prism::to_8bit(embree[0].image), 1) == 0.0);
     // Culling changed the image at all (the box's inside shows through its front faces).
-    options.cull_backfaces = false;
+    options.backface_culling = prism::BackfaceCulling::none;
     const auto unculled = prism::render_scene(world, options, log);
     CHECK(prism::share_off_by_more_than(own_bytes, prism::to_8bit(unculled[0].image), 1) > 0.0);
 }

@@ -63,6 +63,10 @@ public:
             else usage_error("--accelerator must be prism or embree");
             if (options.accelerator == AcceleratorChoice::embree && !embree_available)
                 usage_error("--accelerator embree: this prism was built without Embree 3 (libembree-dev)");
+        } else if (option == "--cull-backfaces") {
+            options.backface_culling = BackfaceCulling::all;
+        } else if (option == "--no-cull-backfaces") {
+            options.backface_culling = BackfaceCulling::none;
         } else if (option == "--seed") {
             options.seed = number<std::uint64_t>(option, next_value());
         } else {

@@ -3,10 +3,13 @@
 // shading: the scene's shapes, transforms, textures and surface() stay in a SceneGeometry
 // (under BruteForce, whose index is only the identity order and is never traversed), and
 // Embree's scene mirrors its objects, with Embree's geometry IDs equal to prism's object
-// indices. Embree says which primitive of which object is hit first; prism's own test on
-// that one primitive then computes t and the barycentrics, so a hit is shaded from exactly
-// the numbers prism's own accelerator would give for it (the images then differ only where
-// the two traversals pick different primitives: ties on shared edges, grazing rays).
+// indices. Embree only traverses: every triangle its own test accepts is tested again by
+// prism's watertight test in a filter callback, and only prism's yes counts; prism's test on
+// the closest one then computes t and the barycentrics, so a hit is shaded from exactly the
+// numbers prism's own accelerator would give for it. (With Embree's answer taken as it was,
+// 13 of the 57 hw1/hw2 course images lost 0.01 to 1 dB: edges Embree's float test hits and the
+// watertight test gives to the neighbour.) The images then differ only where two triangles
+// tie at a shared edge and the two traversals pick different ones.
 // Needs libembree-dev; the CMake build defines PRISM_WITH_EMBREE when it finds it.
 #pragma once
 
@@ -38,12 +41,10 @@ struct Embree {
     template <Scalar Real, bool MotionBlur> using Geometry = EmbreeGeometry<Real, MotionBlur>;
 };
 
-// Embree's traversal and triangle test are in float. In a double renderer that is not enough:
-// rays leave surfaces by double-precision error bounds, far below a float ulp, and Embree's
-// float test then finds the surface a ray just left (4% of the shadow rays of hw2
-// horse_instanced came back occluded). So in double every triangle Embree's test accepts is
-// tested again by prism's double test in a filter callback, and only prism's yes counts:
-// Embree only traverses. (In float prism's test runs once, on the closest triangle.)
+// Embree's traversal and triangle test are in float. In a double renderer the filter's test is
+// prism's double test: rays leave surfaces by double-precision error bounds, far below a float
+// ulp, and Embree's float test alone finds the surface a ray just left (4% of the shadow rays
+// of hw2 horse_instanced came back occluded).
 template <Scalar Real, bool MotionBlur = false>
 class EmbreeGeometry {
 public:
@@ -71,21 +72,21 @@ public:
     Aabb<Real> bounds() const { return shapes_.bounds(); }
 
     // Closest hit in (ray.t_min, ray.t_max]; on a hit, ray.t_max becomes the hit distance.
-    template <bool CullBackfaces = false>
+    template <BackfaceCulling Culling = BackfaceCulling::none>
     bool intersect(Ray<Real>& ray, Hit<Real>& hit) const {
         RTCRayHit ray_hit;
         ray_hit.ray = embree_ray(ray, ray.t_max);
         ray_hit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         ray_hit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         Context context(this, ray);
-        context.base.filter = filter_for<CullBackfaces, false>();
+        context.base.filter = filter_for<Culling, false>();
         rtcIntersect1(scene_.get(), &context.base, &ray_hit);
         bool found = false;
         if (ray_hit.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
             const std::uint32_t object =
                 ray_hit.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? ray_hit.hit.instID[0] : ray_hit.hit.geomID;
-            // prism's test on Embree's primitive; where it declines (Embree's float test took an
-            // edge prism's watertight test gives to the neighbour) Embree's own numbers stand.
+            // prism's test on Embree's primitive, which the filter accepted with the same ray:
+            // the fallback to Embree's numbers is for safety only.
             Ray<Real> probe = ray;
             if (!shapes_.intersect_primitive(object, ray_hit.hit.primID, probe, hit))
                 hit = Hit<Real>{Real(ray_hit.ray.tfar), object, ray_hit.hit.primID, Real(ray_hit.hit.u),
@@ -93,19 +94,18 @@ public:
             ray.t_max = hit.t;
             found = true;
         }
-        return shapes_.template intersect_planes<CullBackfaces>(ray, hit) || found;
+        return shapes_.template intersect_planes<Culling>(ray, hit) || found;
     }
 
     // Whether anything lies in (ray.t_min, ray.t_max): open at t_max, like prism's own.
     bool occluded(const Ray<Real>& ray) const {
         RTCRay embree = embree_ray(ray, ray.t_max);
-        // Open at t_max: in float Embree's closed interval is shortened by an ulp; in double
-        // prism's test in the filter decides, so Embree's interval must not end early.
+        // Open at t_max: prism's test in the filter decides, so Embree's closed interval must
+        // not end early (a double t_max rounded down to float would).
         if (embree.tfar < std::numeric_limits<float>::infinity())
-            embree.tfar = std::nextafter(embree.tfar, exact_filter ? std::numeric_limits<float>::infinity()
-                                                                   : -std::numeric_limits<float>::infinity());
+            embree.tfar = std::nextafter(embree.tfar, std::numeric_limits<float>::infinity());
         Context context(this, ray);
-        context.base.filter = filter_for<false, true>();
+        context.base.filter = filter_for<BackfaceCulling::none, true>();
         rtcOccluded1(scene_.get(), &context.base, &embree);
         return embree.tfar == -std::numeric_limits<float>::infinity() || shapes_.occluded_by_planes(ray);
     }
@@ -315,38 +315,34 @@ private:
             RTCRayN_tfar(args->ray, args->N, 0) = -std::numeric_limits<float>::infinity();
     }
 
-    // Primary rays with culling: a triangle whose winding faces away from the ray is no hit.
+    // Camera rays with culling (geometry/backface_culling.hpp): a triangle whose winding faces
+    // away from the ray is no hit.
     // prism culls where (v1 - v0) x (v2 - v0) . d > 0; Embree's Ng points the same way (tested
     // against prism's own culling in tests/test_embree.cpp), ray and normal both in the
     // triangle's object space.
-    static constexpr bool exact_filter = !std::is_same_v<Real, float>;
-
-    // The context filter a query needs (nullptr: none, Embree's own test decides).
-    template <bool CullBackfaces, bool AnyHit>
+    // The context filter of a query: culling, then prism's test.
+    template <BackfaceCulling Culling, bool AnyHit>
     static RTCFilterFunctionN filter_for() {
-        if constexpr (CullBackfaces || exact_filter) return &filter<CullBackfaces, AnyHit>;
-        else return nullptr;
+        return &filter<Culling, AnyHit>;
     }
 
-    template <bool CullBackfaces, bool AnyHit>
+    template <BackfaceCulling Culling, bool AnyHit>
     static void filter(const RTCFilterFunctionNArguments* args) {
         if (!args->valid[0]) return;
-        if constexpr (CullBackfaces) {
-            cull_backfaces(args);
+        const auto* context = reinterpret_cast<const Context*>(args->context);
+        const unsigned instance = RTCHitN_instID(args->hit, args->N, 0, 0);
+        const std::uint32_t object =
+            instance != RTC_INVALID_GEOMETRY_ID ? instance : RTCHitN_geomID(args->hit, args->N, 0);
+        if constexpr (Culling != BackfaceCulling::none) {
+            if (context->self->shapes_.culls(object, Culling)) cull_backfaces(args);
             if (!args->valid[0]) return;
         }
-        if constexpr (exact_filter) {
-            const auto* context = reinterpret_cast<const Context*>(args->context);
-            const unsigned instance = RTCHitN_instID(args->hit, args->N, 0, 0);
-            const std::uint32_t object =
-                instance != RTC_INVALID_GEOMETRY_ID ? instance : RTCHitN_geomID(args->hit, args->N, 0);
-            Ray<Real> ray = *context->world_ray;
-            const Real t_max = ray.t_max;
-            Hit<Real> hit;
-            const bool hit_by_prism =
-                context->self->shapes_.intersect_primitive(object, RTCHitN_primID(args->hit, args->N, 0), ray, hit);
-            if (!hit_by_prism || (AnyHit && !(hit.t < t_max))) args->valid[0] = 0;
-        }
+        Ray<Real> ray = *context->world_ray;
+        const Real t_max = ray.t_max;
+        Hit<Real> hit;
+        const bool hit_by_prism =
+            context->self->shapes_.intersect_primitive(object, RTCHitN_primID(args->hit, args->N, 0), ray, hit);
+        if (!hit_by_prism || (AnyHit && !(hit.t < t_max))) args->valid[0] = 0;
     }
 
     static void cull_backfaces(const RTCFilterFunctionNArguments* args) {

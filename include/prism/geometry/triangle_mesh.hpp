@@ -58,6 +58,7 @@ public:
 
     Aabb<Real> bounds() const { return bounds_; }
     std::size_t triangle_count() const { return triangles_.size(); }
+    bool smooth() const { return smooth_; }  // shadingMode="smooth": normals interpolated from the vertices
     // What traversal reads: the index and the triangles its leaves test (not the shading data).
     std::size_t accelerator_bytes() const { return index_.memory_bytes() + triangles_.capacity() * sizeof(triangles_[0]); }
 
