@@ -51,6 +51,9 @@ options:
                        epsilon, unless it is below 64 ulps of the scene's largest coordinate
   --seed N             selects the pixels' random streams (default 0); any thread count gives
                        the same image for the same seed
+  --accelerator A      prism (its own BVH; the default) or embree: Embree 3 finds the hits,
+                       prism tests the triangle it finds and shades (float; only when built
+                       with libembree-dev)
   --untyped-mirrors M  a material with no type but a MirrorReflectance: ignore (Blinn-Phong only,
                        as the course's images of 2021-2025 scenes show; the default) or
                        reflect (a mirror, as 2017-2019 scene files, written before material
