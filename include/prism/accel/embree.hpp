@@ -3,13 +3,13 @@
 // shading: the scene's shapes, transforms, textures and surface() stay in a SceneGeometry
 // (under BruteForce, whose index is only the identity order and is never traversed), and
 // Embree's scene mirrors its objects, with Embree's geometry IDs equal to prism's object
-// indices. Embree only traverses: every triangle its own test accepts is tested again by
-// prism's watertight test in a filter callback, and only prism's yes counts; prism's test on
-// the closest one then computes t and the barycentrics, so a hit is shaded from exactly the
-// numbers prism's own accelerator would give for it. (With Embree's answer taken as it was,
-// 13 of the 57 hw1/hw2 course images lost 0.01 to 1 dB: edges Embree's float test hits and the
-// watertight test gives to the neighbour.) The images then differ only where two triangles
-// tie at a shared edge and the two traversals pick different ones.
+// indices. Embree says which triangle of which object is hit first; prism's own test on that
+// one triangle then computes t and the barycentrics, so a hit is shaded from exactly the
+// numbers prism's own accelerator would give for it; where prism's test declines (an edge
+// Embree's float test takes and the watertight test gives to the neighbour) Embree's own
+// numbers stand. Rejecting such candidates in a filter instead, so that prism decides every
+// one, made it worse in float (hw1 bunny 102.3 -> 78.2 dB): Embree's test then never offers the
+// neighbour the watertight test would have taken, and the ray leaks through the edge.
 // Needs libembree-dev; the CMake build defines PRISM_WITH_EMBREE when it finds it.
 #pragma once
 
@@ -41,10 +41,11 @@ struct Embree {
     template <Scalar Real, bool MotionBlur> using Geometry = EmbreeGeometry<Real, MotionBlur>;
 };
 
-// Embree's traversal and triangle test are in float. In a double renderer the filter's test is
-// prism's double test: rays leave surfaces by double-precision error bounds, far below a float
-// ulp, and Embree's float test alone finds the surface a ray just left (4% of the shadow rays
-// of hw2 horse_instanced came back occluded).
+// Embree's traversal and triangle test are in float. In a double renderer that is not enough:
+// rays leave surfaces by double-precision error bounds, far below a float ulp, and Embree's
+// float test alone finds the surface a ray just left (4% of the shadow rays of hw2
+// horse_instanced came back occluded). So in double every triangle Embree's test accepts is
+// tested again by prism's double test in a filter callback, and only prism's yes counts.
 template <Scalar Real, bool MotionBlur = false>
 class EmbreeGeometry {
 public:
@@ -85,8 +86,7 @@ public:
         if (ray_hit.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
             const std::uint32_t object =
                 ray_hit.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? ray_hit.hit.instID[0] : ray_hit.hit.geomID;
-            // prism's test on Embree's primitive, which the filter accepted with the same ray:
-            // the fallback to Embree's numbers is for safety only.
+            // prism's test on Embree's primitive (in double the filter already accepted it).
             Ray<Real> probe = ray;
             if (!shapes_.intersect_primitive(object, ray_hit.hit.primID, probe, hit))
                 hit = Hit<Real>{Real(ray_hit.ray.tfar), object, ray_hit.hit.primID, Real(ray_hit.hit.u),
@@ -100,10 +100,11 @@ public:
     // Whether anything lies in (ray.t_min, ray.t_max): open at t_max, like prism's own.
     bool occluded(const Ray<Real>& ray) const {
         RTCRay embree = embree_ray(ray, ray.t_max);
-        // Open at t_max: prism's test in the filter decides, so Embree's closed interval must
-        // not end early (a double t_max rounded down to float would).
+        // Open at t_max: in float Embree's closed interval is shortened by an ulp; in double
+        // prism's test in the filter decides, so Embree's interval must not end early.
         if (embree.tfar < std::numeric_limits<float>::infinity())
-            embree.tfar = std::nextafter(embree.tfar, std::numeric_limits<float>::infinity());
+            embree.tfar = std::nextafter(embree.tfar, exact_filter ? std::numeric_limits<float>::infinity()
+                                                                   : -std::numeric_limits<float>::infinity());
         Context context(this, ray);
         context.base.filter = filter_for<BackfaceCulling::none, true>();
         rtcOccluded1(scene_.get(), &context.base, &embree);
@@ -315,15 +316,14 @@ private:
             RTCRayN_tfar(args->ray, args->N, 0) = -std::numeric_limits<float>::infinity();
     }
 
-    // Camera rays with culling (geometry/backface_culling.hpp): a triangle whose winding faces
-    // away from the ray is no hit.
-    // prism culls where (v1 - v0) x (v2 - v0) . d > 0; Embree's Ng points the same way (tested
-    // against prism's own culling in tests/test_embree.cpp), ray and normal both in the
-    // triangle's object space.
-    // The context filter of a query: culling, then prism's test.
+    static constexpr bool exact_filter = !std::is_same_v<Real, float>;
+
+    // The context filter of a query: culling (camera rays, geometry/backface_culling.hpp), then
+    // in double prism's test; none when neither applies.
     template <BackfaceCulling Culling, bool AnyHit>
     static RTCFilterFunctionN filter_for() {
-        return &filter<Culling, AnyHit>;
+        if constexpr (Culling != BackfaceCulling::none || exact_filter) return &filter<Culling, AnyHit>;
+        else return nullptr;
     }
 
     template <BackfaceCulling Culling, bool AnyHit>
@@ -333,23 +333,23 @@ private:
         const unsigned instance = RTCHitN_instID(args->hit, args->N, 0, 0);
         const std::uint32_t object =
             instance != RTC_INVALID_GEOMETRY_ID ? instance : RTCHitN_geomID(args->hit, args->N, 0);
+        const std::uint32_t primitive = RTCHitN_primID(args->hit, args->N, 0);
         if constexpr (Culling != BackfaceCulling::none) {
-            if (context->self->shapes_.culls(object, Culling)) cull_backfaces(args);
-            if (!args->valid[0]) return;
+            // prism's own orientation test, on prism's triangle and ray: with Embree's rounded
+            // normal and ray, grazing triangles (hw1 rt_raven's) came out on the other side
+            // (81.8 -> 72.7 dB).
+            if (context->self->shapes_.culled(object, primitive, *context->world_ray, Culling)) {
+                args->valid[0] = 0;
+                return;
+            }
         }
-        Ray<Real> ray = *context->world_ray;
-        const Real t_max = ray.t_max;
-        Hit<Real> hit;
-        const bool hit_by_prism =
-            context->self->shapes_.intersect_primitive(object, RTCHitN_primID(args->hit, args->N, 0), ray, hit);
-        if (!hit_by_prism || (AnyHit && !(hit.t < t_max))) args->valid[0] = 0;
-    }
-
-    static void cull_backfaces(const RTCFilterFunctionNArguments* args) {
-        const float dot = RTCRayN_dir_x(args->ray, args->N, 0) * RTCHitN_Ng_x(args->hit, args->N, 0) +
-                          RTCRayN_dir_y(args->ray, args->N, 0) * RTCHitN_Ng_y(args->hit, args->N, 0) +
-                          RTCRayN_dir_z(args->ray, args->N, 0) * RTCHitN_Ng_z(args->hit, args->N, 0);
-        if (dot > 0) args->valid[0] = 0;
+        if constexpr (exact_filter) {
+            Ray<Real> ray = *context->world_ray;
+            const Real t_max = ray.t_max;
+            Hit<Real> hit;
+            const bool hit_by_prism = context->self->shapes_.intersect_primitive(object, primitive, ray, hit);
+            if (!hit_by_prism || (AnyHit && !(hit.t < t_max))) args->valid[0] = 0;
+        }
     }
 
     Shapes shapes_;

@@ -188,6 +188,13 @@ public:
     // What an outside index needs to mirror the objects: whether object i is a sphere, and the
     // world box intersect's own index holds for it (covering a moving object's sweep).
     bool is_sphere(std::uint32_t object) const { return instances_[object].kind == Kind::sphere; }
+    // Whether `culling` skips this triangle of this object for this (world-space) ray, decided
+    // as intersect decides it.
+    bool culled(std::uint32_t object, std::uint32_t primitive, const Ray<Real>& ray, BackfaceCulling culling) const {
+        if (!culls(object, culling)) return false;
+        const Instance& instance = instances_[object];
+        return meshes_[instance.shape].faces_away(primitive, to_object(instance, ray).direction);
+    }
     // Whether camera rays skip object's back-facing triangles under `culling`, as intersect does.
     bool culls(std::uint32_t object, BackfaceCulling culling) const {
         const Instance& instance = instances_[object];

@@ -91,6 +91,13 @@ public:
         return found;
     }
 
+    // Whether culling skips the triangle in `slot` for a ray of this direction (object space):
+    // the test intersect<true> makes.
+    bool faces_away(std::uint32_t slot, const Vec3<Real>& direction) const {
+        const auto& p = triangles_[slot];
+        return glm::dot(Vec3<Real>(glm::cross(p[1] - p[0], p[2] - p[0])), direction) > 0;
+    }
+
     // The triangle in `slot` alone, with the same test and the same hit record as intersect.
     bool intersect_triangle(std::uint32_t slot, const Ray<Real>& ray, Real& t_max, Hit<Real>& hit) const {
         const auto& p = triangles_[slot];
