@@ -3,6 +3,7 @@
 // sampling strategy, the same sky in both layouts, the shared envmaps (every file reads; the
 // Uffizi lat-long and its derived probe agree; importance sampling tames Venice's sun), and the
 // prism-envmap command.
+#include "chi_square.hpp"
 #include "temporary_folder.hpp"
 
 #include <prism/image/image_io.hpp>
@@ -35,6 +36,7 @@ using prism::Vec2;
 using prism::Vec3;
 using Layout = scene::EnvironmentLayout;
 using Sampling = scene::EnvironmentSampling;
+using prism_test::pearson_chi_square;
 
 constexpr double pi = 3.14159265358979323846;
 
@@ -112,24 +114,6 @@ void check_mapping(ToImage to_image, ToDirection to_direction, const Vec2<Real> 
         if (direction.z > Real(0.999)) continue;
         CHECK(glm::length(to_direction(to_image(direction)) - direction) < 50 * tolerance);
     }
-}
-
-// Pearson's statistic of the counts drawn from a table against the table's proportions, over
-// its non-zero cells; a zero cell must never be drawn.
-template <class Real>
-double pearson_chi_square(const std::vector<Real>& table, const std::vector<int>& hits, int count) {
-    double total = 0;
-    for (const Real value : table) total += double(value);
-    double chi_square = 0;
-    for (std::size_t i = 0; i < table.size(); ++i) {
-        if (table[i] == 0) {
-            CHECK(hits[i] == 0);
-            continue;
-        }
-        const double expected = count * double(table[i]) / total;
-        chi_square += (hits[i] - expected) * (hits[i] - expected) / expected;
-    }
-    return chi_square;
 }
 
 }  // namespace

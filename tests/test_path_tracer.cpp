@@ -54,13 +54,14 @@ scene::Camera camera_at(const glm::dvec3& position, const glm::dvec3& gaze, int 
 }
 
 // A closed cube (side 2, centred at the origin) that emits Le = 1 everywhere and reflects
-// diffusely with albedo rho = 1/2 (the stand-in BRDF's kd / pi). Every point sees the same
+// diffusely with albedo rho = 1/2 (a normalised ModifiedPhong with ks = 0: kd / pi). Every point sees the same
 // radiance, so L = Le (1 + rho + ... + rho^D) after at most D bounces: 1.875 for D = 3.
 scene::Scene furnace() {
     scene::Scene world;
     world.max_recursion_depth = 3;
     scene::Material material;
     material.diffuse = {0.5, 0.5, 0.5};
+    material.brdf = scene::Brdf{"1", scene::BrdfModel::modified_phong, 10.0, true, false};
     world.materials.push_back(material);
     scene::Mesh cube;
     for (int i = 0; i < 8; ++i) cube.positions.push_back({i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1});
@@ -79,8 +80,8 @@ double mean_of(const prism::Image& image) {
     return sum / (image.width * image.height);
 }
 
-// A small Cornell box: white floor, back wall and ceiling, a red left and a green right wall,
-// a grey sphere, a LightMesh square below the ceiling and a small LightSphere; a point light
+// A small Cornell box: white floor, back wall and ceiling, a red left and a green right wall
+// (normalised diffuse), a glossy sphere (normalised ModifiedBlinnPhong), a LightMesh square below the ceiling and a small LightSphere; a point light
 // too, which only next-event estimation can see, so it is left out here (all combinations must
 // estimate the same image).
 const char* const cornell_xml = R"(<Scene>
@@ -92,12 +93,16 @@ const char* const cornell_xml = R"(<Scene>
         <NumSamples>256</NumSamples>
         <Renderer>PathTracing</Renderer>
     </Camera></Cameras>
+    <BRDFs>
+        <ModifiedPhong id="1" normalized="true"><Exponent>1</Exponent></ModifiedPhong>
+        <ModifiedBlinnPhong id="2" normalized="true"><Exponent>20</Exponent></ModifiedBlinnPhong>
+    </BRDFs>
     <Materials>
-        <Material id="1"><DiffuseReflectance>0.8 0.8 0.8</DiffuseReflectance></Material>
-        <Material id="2"><DiffuseReflectance>0.8 0.2 0.2</DiffuseReflectance></Material>
-        <Material id="3"><DiffuseReflectance>0.2 0.8 0.2</DiffuseReflectance></Material>
-        <Material id="4"><DiffuseReflectance>0.5 0.5 0.5</DiffuseReflectance>
-            <SpecularReflectance>0.3 0.3 0.3</SpecularReflectance><PhongExponent>20</PhongExponent></Material>
+        <Material id="1" BRDF="1"><DiffuseReflectance>0.8 0.8 0.8</DiffuseReflectance></Material>
+        <Material id="2" BRDF="1"><DiffuseReflectance>0.8 0.2 0.2</DiffuseReflectance></Material>
+        <Material id="3" BRDF="1"><DiffuseReflectance>0.2 0.8 0.2</DiffuseReflectance></Material>
+        <Material id="4" BRDF="2"><DiffuseReflectance>0.5 0.5 0.5</DiffuseReflectance>
+            <SpecularReflectance>0.3 0.3 0.3</SpecularReflectance></Material>
         <Material id="5"><DiffuseReflectance>0 0 0</DiffuseReflectance></Material>
     </Materials>
     <VertexData>
@@ -122,7 +127,9 @@ const char* const cornell_xml = R"(<Scene>
 TEST_CASE_TEMPLATE("PathTracer: a furnace renders its analytic radiance within 1% under every RendererParams", Real,
                    float, double) {
     scene::Scene world = furnace();
-    const prism::Renderer<PathConfig<Real>> renderer(world);
+    prism::RendererSettings settings;
+    settings.backface_culling = prism::BackfaceCulling::none;  // the camera is inside the cube
+    const prism::Renderer<PathConfig<Real>> renderer(world, settings);
     for (const scene::RendererParams& params : all_params()) {
         CAPTURE(describe(params));
         scene::Camera camera = world.cameras[0];
@@ -148,8 +155,10 @@ TEST_CASE_TEMPLATE("PathTracer: every RendererParams combination converges to th
     const auto estimate = [&](const scene::RendererParams& params) {
         std::vector<std::vector<double>> blocks;  // per seed
         for (int s = 0; s < seeds; ++s) {
-            const prism::Renderer<PathConfig<Real>> renderer(world, prism::RendererSettings{false, prism::RayOffset::scene_epsilon,
-                                                                                             std::uint64_t(s + 1)});
+            prism::RendererSettings settings;
+            settings.backface_culling = prism::BackfaceCulling::none;  // the box's walls face either way
+            settings.seed = std::uint64_t(s + 1);
+            const prism::Renderer<PathConfig<Real>> renderer(world, settings);
             scene::Camera camera = world.cameras[0];
             camera.renderer = params;
             const prism::Image image = renderer.render(camera);
@@ -193,6 +202,7 @@ TEST_CASE("PathTracer: the same seed gives the same image at 1 and 2 threads") {
     std::ostringstream log;
     prism::RenderOptions one;
     one.threads = 1;
+    one.backface_culling = prism::BackfaceCulling::none;
     prism::RenderOptions two = one;
     two.threads = 2;
     const auto first = prism::render_scene(world, one, log);

@@ -28,6 +28,7 @@
 #include <prism/io/limits.hpp>
 #include <prism/io/load_error.hpp>
 #include <prism/io/ply.hpp>
+#include <prism/io/brdf_loader.hpp>
 #include <prism/io/texture_loader.hpp>
 #include <prism/math/transform.hpp>
 #include <prism/scene/scene.hpp>
@@ -79,6 +80,8 @@ public:
         // Definitions first, wherever the file puts them: objects and cameras refer to them.
         check_single(root, {"BackgroundColor", "ShadowRayEpsilon", "IntersectionTestEpsilon", "MaxRecursionDepth",
                             "VertexData", "TexCoordData"});
+        for (const Element& child : root.children)
+            if (child.name == "BRDFs") brdfs_.read(child);  // before the materials that name them
         for (const Element& child : root.children) {
             if (child.name == "VertexData") read_vertex_data(child);
             else if (child.name == "TexCoordData") read_texture_coordinates(child);
@@ -99,7 +102,7 @@ public:
             else if (name == "Lights") read_lights(child);
             else if (name == "Objects") read_objects(child);
             else if (name != "VertexData" && name != "TexCoordData" && name != "Transformations" && name != "Materials" &&
-                     name != "Textures")
+                     name != "Textures" && name != "BRDFs")
                 note_unsupported(child);
         }
         scene_.unsupported = take_unsupported();
@@ -218,6 +221,7 @@ private:
             if (const Element* e = element.child("AbsorptionCoefficient")) material.absorption_coefficient = vector3(*e);
             if (const Element* e = element.child("Transparency")) material.transparency = vector3(*e);
             if (const Element* e = element.child("Roughness")) material.roughness = non_negative(*e);
+            material.brdf = brdfs_.brdf_of(element);
             material.degamma = boolean_attribute(element, "degamma", false);
             if (material.degamma) linearise_reflectances(element, material);
 
@@ -908,6 +912,7 @@ private:
     LoadOptions options_;
     scene::Scene scene_;
     TextureLoader textures_{*this, scene_};
+    BrdfLoader brdfs_{*this};
     std::vector<scene::Vec3> vertices_;
     std::vector<scene::Vec2> texture_coordinates_;
     std::map<std::string, glm::dmat4> transformations_;  // key: kind letter and id, as referenced ("t1")

@@ -29,6 +29,7 @@
 #include <prism/io/load_error.hpp>
 #include <prism/light/environment_map.hpp>
 #include <prism/light/light_sample.hpp>
+#include <prism/sampling/hemisphere.hpp>
 #include <prism/sampling/piecewise_constant.hpp>
 
 #include <algorithm>
@@ -38,39 +39,6 @@
 #include <vector>
 
 namespace prism {
-
-// Two unit vectors completing `normal` (unit) to a right-handed orthonormal frame, without
-// branches on the normal's orientation (Duff, Burgess, Christensen, Hery, Kensler, Liani and
-// Villemin, "Building an Orthonormal Basis, Revisited", JCGT 6(1), 2017).
-template <Scalar Real>
-std::pair<Vec3<Real>, Vec3<Real>> orthonormal_basis(const Vec3<Real>& normal) {
-    const Real sign = std::copysign(Real(1), normal.z);
-    const Real a = -1 / (sign + normal.z);
-    const Real b = normal.x * normal.y * a;
-    return {Vec3<Real>(1 + sign * normal.x * normal.x * a, sign * b, -sign * normal.x),
-            Vec3<Real>(b, sign + normal.y * normal.y * a, -normal.y)};
-}
-
-// The direction with cosine `cos_theta` to `normal` and azimuth 2 pi u around it.
-template <Scalar Real>
-Vec3<Real> hemisphere_direction(const Vec3<Real>& normal, Real cos_theta, Real u) {
-    const auto [tangent, bitangent] = orthonormal_basis(normal);
-    const Real sin_theta = std::sqrt(std::max(Real(0), 1 - cos_theta * cos_theta));
-    const Real phi = 2 * pi<Real> * u;
-    return sin_theta * std::cos(phi) * tangent + sin_theta * std::sin(phi) * bitangent + cos_theta * normal;
-}
-
-// Uniform over the hemisphere around `normal`: cos(theta) = 1 - u.x in (0, 1], density 1 / (2 pi).
-template <Scalar Real>
-Vec3<Real> sample_uniform_hemisphere(const Vec3<Real>& normal, const Vec2<Real>& u) {
-    return hemisphere_direction(normal, 1 - u.x, u.y);
-}
-
-// Cosine-weighted: sin^2(theta) = u.x, so cos(theta) = sqrt(1 - u.x) in (0, 1], density cos / pi.
-template <Scalar Real>
-Vec3<Real> sample_cosine_hemisphere(const Vec3<Real>& normal, const Vec2<Real>& u) {
-    return hemisphere_direction(normal, std::sqrt(1 - u.x), u.y);
-}
 
 template <Scalar Real>
 class EnvironmentLight {

@@ -8,9 +8,9 @@
 // transformation at that point, |det M| |M^-T n|, so the estimate stays exact for any affine map.
 #pragma once
 
-#include <prism/light/environment_light.hpp>  // orthonormal_basis
 #include <prism/light/light_mesh.hpp>
 #include <prism/light/light_sample.hpp>
+#include <prism/sampling/hemisphere.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -1,7 +1,7 @@
 // Path tracing (Kajiya 1986), as the course's <Renderer>PathTracing</Renderer> asks for it, with
 // the <RendererParams> each camera lists:
-// - ImportanceSampling: directions drawn from the BRDF (cosine-weighted for a diffuse surface)
-//   rather than uniformly over the hemisphere;
+// - ImportanceSampling: directions drawn from the material's BRDF (material/brdf.hpp: its
+//   specular lobe or the cosine-weighted hemisphere) rather than uniformly over the hemisphere;
 // - NextEventEstimation: every light sampled at every non-specular vertex (Whitted-style shadow
 //   rays), and emission that a BRDF-sampled ray then finds not counted again;
 // - RussianRoulette: a path continues with probability q = min(1, max throughput) and its
@@ -21,7 +21,9 @@
 #include <prism/light/environment_light.hpp>
 #include <prism/light/light_mesh.hpp>
 #include <prism/light/light_sphere.hpp>
+#include <prism/material/brdf.hpp>
 #include <prism/render/whitted_integrator.hpp>
+#include <prism/sampling/hemisphere.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -30,33 +32,7 @@
 
 namespace prism {
 
-// Stand-in surface model until the course's BRDFs (material/brdf.hpp) are merged: a
-// normalised modified Blinn-Phong, kd / pi + ks (p + 8) / (8 pi) cos^p(theta_h), sampled
-// cosine-weighted.
 namespace path_tracing {
-
-template <Scalar Real>
-Vec3<Real> evaluate(const Material<Real>& material, const Vec3<Real>& normal, const Vec3<Real>& wi,
-                    const Vec3<Real>& wo) {
-    Vec3<Real> value = material.diffuse / pi<Real>;
-    if (material.specular != Vec3<Real>(0)) {
-        const Vec3<Real> half_vector = glm::normalize(wi + wo);
-        const Real cos_half = std::max(glm::dot(normal, half_vector), Real(0));
-        value += material.specular * ((material.phong_exponent + 8) / (8 * pi<Real>) *
-                                      std::pow(cos_half, material.phong_exponent));
-    }
-    return value;
-}
-
-template <Scalar Real>
-Real importance_pdf(const Vec3<Real>& normal, const Vec3<Real>& wi) {
-    return std::max(glm::dot(normal, wi), Real(0)) / pi<Real>;
-}
-
-template <Scalar Real>
-Vec3<Real> importance_sample(const Vec3<Real>& normal, const Vec2<Real>& u) {
-    return sample_cosine_hemisphere(normal, u);
-}
 
 // Veach's power heuristic with exponent 2, for one sample of each strategy.
 template <Scalar Real>
@@ -125,8 +101,7 @@ private:
         Real travelled = 0;
         for (int depth = 0;; ++depth) {
             Hit<Real> hit;
-            const bool found = (depth == 0 && settings_.cull_backfaces) ? geometry_.template intersect<true>(ray, hit)
-                                                                        : geometry_.template intersect<false>(ray, hit);
+            const bool found = intersect(ray, depth, hit);
             if (!found) {
                 color += throughput * escaped(ray.direction, depth, count_emission, path.pixel_uv);
                 break;
@@ -165,13 +140,21 @@ private:
                 const Vec3<Real> wo = -d;
                 if (params.next_event_estimation)
                     color += throughput * direct_lighting(point, normal, wo, material, params, random);
-                direction = params.importance_sampling
-                                ? path_tracing::importance_sample(normal, random.uniform2<Real>())
-                                : sample_uniform_hemisphere(normal, random.uniform2<Real>());
-                const Real density = scatter_density(params, normal, direction);
+                Real density;
+                Vec3<Real> value;
+                if (params.importance_sampling) {
+                    const BrdfSample<Real> sample = sample_brdf(material, normal, wo, random.uniform2<Real>());
+                    direction = sample.direction;
+                    density = sample.pdf;
+                    value = sample.value;
+                } else {
+                    direction = sample_uniform_hemisphere(normal, random.uniform2<Real>());
+                    density = 1 / (2 * pi<Real>);
+                    value = evaluate_brdf(material, normal, direction, wo);
+                }
                 const Real cos_theta = glm::dot(normal, direction);
                 if (!(density > 0) || !(cos_theta > 0)) break;
-                throughput *= path_tracing::evaluate(material, normal, direction, wo) * (cos_theta / density);
+                throughput *= value * (cos_theta / density);
                 scatter_pdf = density;
                 count_emission = !params.next_event_estimation;
             }
@@ -185,6 +168,20 @@ private:
             ray = leaving(point, normal, direction, ray.time);
         }
         return color;
+    }
+
+    // The closest hit, camera rays skipping back faces as the ray tracer does
+    // (settings_.backface_culling), so both integrators see the same first surfaces.
+    bool intersect(Ray<Real>& ray, int depth, Hit<Real>& hit) const {
+        if (depth == 0) {
+            switch (settings_.backface_culling) {
+                case BackfaceCulling::none: break;
+                case BackfaceCulling::flat_triangles:
+                    return geometry_.template intersect<BackfaceCulling::flat_triangles>(ray, hit);
+                case BackfaceCulling::all: return geometry_.template intersect<BackfaceCulling::all>(ray, hit);
+            }
+        }
+        return geometry_.template intersect<BackfaceCulling::none>(ray, hit);
     }
 
     // Mirrors and conductors reflect; dielectrics reflect or refract, chosen by the Fresnel
@@ -235,10 +232,9 @@ private:
                 shadow.t_max = glm::length(target - shadow.origin) * (1 - Real(1e-4));
             }
             if (geometry_.occluded(shadow)) return;
-            Vec3<Real> contribution = path_tracing::evaluate(material, normal, sample.direction, wo) * cos_light *
-                                      sample.radiance;
+            Vec3<Real> contribution = evaluate_brdf(material, normal, sample.direction, wo) * cos_light * sample.radiance;
             if (params.multiple_importance && sample.pdf > 0)
-                contribution *= path_tracing::power_heuristic(sample.pdf, scatter_density(params, normal, sample.direction));
+                contribution *= path_tracing::power_heuristic(sample.pdf, scatter_density(params, material, normal, sample.direction, wo));
             color += contribution;
         });
         return color;
@@ -246,8 +242,9 @@ private:
 
     // The solid-angle density with which the path's next direction is drawn: from the BRDF with
     // ImportanceSampling, uniformly over the hemisphere without.
-    static Real scatter_density(const scene::RendererParams& params, const Vec3<Real>& normal, const Vec3<Real>& wi) {
-        if (params.importance_sampling) return path_tracing::importance_pdf(normal, wi);
+    static Real scatter_density(const scene::RendererParams& params, const Material<Real>& material,
+                                const Vec3<Real>& normal, const Vec3<Real>& wi, const Vec3<Real>& wo) {
+        if (params.importance_sampling) return brdf_pdf(material, normal, wi, wo);
         return glm::dot(normal, wi) > 0 ? 1 / (2 * pi<Real>) : Real(0);
     }
 

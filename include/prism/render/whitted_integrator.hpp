@@ -211,6 +211,11 @@ private:
                 shadow.direction = glm::normalize(position + sample.direction * sample.distance - shadow.origin);
             shadow.t_max = sample.distance;
             if (geometry_.occluded(shadow)) return;
+            if (material.brdf_given) {
+                color += evaluate_brdf(material, normal, sample.direction, to_viewer) * cos_light * sample.radiance;
+                return;
+            }
+            // No BRDF: hw1-hw5's Blinn-Phong, kept in this form so their images stay bit-identical.
             const Vec3<Real> half_vector = glm::normalize(sample.direction + to_viewer);
             const Real cos_half = std::max(glm::dot(normal, half_vector), Real(0));
             color += (material.diffuse * cos_light + material.specular * std::pow(cos_half, material.phong_exponent)) *

@@ -137,6 +137,18 @@ struct EnvironmentLight {
 
 enum class MaterialType { blinn_phong, mirror, conductor, dielectric };
 
+// A <BRDFs> entry (CENG795 hw6), copied into each material that names it by BRDF="id". The
+// formulas are in material/brdf/.
+enum class BrdfModel { original_phong, modified_phong, original_blinn_phong, modified_blinn_phong, torrance_sparrow };
+
+struct Brdf {
+    std::string id;
+    BrdfModel model = BrdfModel::original_blinn_phong;
+    double exponent = 1.0;    // <Exponent>
+    bool normalized = false;  // the modified models' normalized="true"
+    bool kdfresnel = false;   // Torrance-Sparrow's kdfresnel="true": kd (1 - F)
+};
+
 struct Material {
     std::string id;
     MaterialType type = MaterialType::blinn_phong;
@@ -155,6 +167,7 @@ struct Material {
     // The reflectances are sRGB-encoded colours: the loader has already linearised them with
     // pow(c, 2.2) when this is set (it is kept for the record).
     bool degamma = false;
+    std::optional<Brdf> brdf;  // none: the course's Blinn-Phong of hw1-hw5
 };
 
 // An image a texture or an environment light reads, decoded once by the loader into linear
