@@ -38,3 +38,23 @@ TEST_CASE("rmse refuses images of different sizes and empty images") {
     CHECK_THROWS_AS(prism::rmse({1, 2, 3}, {1, 2, 3, 4, 5, 6}), std::invalid_argument);
     CHECK_THROWS_AS(prism::rmse({}, {}), std::invalid_argument);
 }
+
+TEST_CASE("display_8bit and mean_grey_exposure: one exposure from the reference, gamma-encoded, clamped") {
+    prism::Image reference(2, 1);
+    reference(0, 0) = glm::vec3(0.1f);
+    reference(1, 0) = glm::vec3(0.26f);
+    // Mean luminance 0.18: the exposure is 1 (luminance weights sum to 1).
+    CHECK(prism::mean_grey_exposure(reference) == doctest::Approx(1.0).epsilon(1e-6));
+    const std::vector<std::uint8_t> bytes = prism::display_8bit(reference, 2.0);
+    REQUIRE(bytes.size() == 6);
+    CHECK(int(bytes[0]) == int(std::lround(255 * std::pow(0.2, 1 / 2.2))));
+    CHECK(int(bytes[3]) == int(std::lround(255 * std::pow(0.52, 1 / 2.2))));
+    CHECK(int(prism::display_8bit(reference, 10.0)[3]) == 255);  // clamped
+    prism::Image black(1, 1);
+    CHECK(prism::mean_grey_exposure(black) == 1.0);
+    // Doubling the reference's radiance halves the exposure: the display is the same.
+    prism::Image brighter = reference;
+    for (auto& pixel : brighter.pixels) pixel *= 2.0f;
+    CHECK(prism::display_8bit(brighter, prism::mean_grey_exposure(brighter)) ==
+          prism::display_8bit(reference, prism::mean_grey_exposure(reference)));
+}

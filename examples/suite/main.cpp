@@ -75,6 +75,12 @@ options:
                        rule, back-facing triangles of flat-shaded meshes only)
   --accelerator A      prism (the default) or embree (Embree 3 finds the hits; only when built
                        with libembree-dev)
+  --hdr                compare radiance, and only images whose reference is HDR (.exr, .hdr):
+                       both images are shown with one exposure, the one bringing the
+                       reference's mean luminance to 0.18, clamped and gamma-encoded (1/2.2) to
+                       8 bits; the reference is box-filtered in radiance. Other images are
+                       listed as `info`. For path-traced references, whose own tone mapping
+                       depends on their noise
   --verbose            print the renderer's log (configuration, build times) on stderr
   --help               this text
 
@@ -121,6 +127,7 @@ struct Arguments {
     int required_rank = 3;
     std::optional<fs::path> output_dir;
     bool verbose = false;
+    bool hdr = false;  // --hdr
     prism::RenderOptions options;
 };
 
@@ -159,6 +166,8 @@ Arguments parse_arguments(int argc, char** argv) {
             arguments.output_dir = fs::path(value());
         } else if (arg == "--verbose") {
             arguments.verbose = true;
+        } else if (arg == "--hdr") {
+            arguments.hdr = true;
         } else if (!arg.empty() && arg[0] == '-') {
             command_line.usage_error("unknown option " + std::string(arg));
         } else if (arguments.input.empty()) {
@@ -376,7 +385,20 @@ Row compare_image(const Arguments& arguments, const prism::scene::Camera& camera
             return row;
         }
         std::vector<std::uint8_t> expected_bytes = prism::to_8bit(expected);
-        if (rendered.image.width != expected.width || rendered.image.height != expected.height) {
+        std::vector<std::uint8_t> actual = prism::to_8bit(rendered.image);
+        const std::string extension = lowercase(reference.path.extension().string());
+        const bool high_dynamic_range = extension == ".exr" || extension == ".hdr";
+        if (arguments.hdr && !high_dynamic_range) {
+            row.status = "info";
+            row.note = "not an HDR reference (--hdr)";
+            return row;
+        }
+        if (arguments.hdr) {
+            const double exposure = prism::mean_grey_exposure(expected);
+            expected_bytes = prism::display_8bit(
+                prism::downsample_box(expected, rendered.image.width, rendered.image.height), exposure);
+            actual = prism::display_8bit(rendered.image, exposure);
+        } else if (rendered.image.width != expected.width || rendered.image.height != expected.height) {
             // Filter what a viewer of the full-size reference sees (its 8-bit values), not
             // radiance above 255 that the reference's PNG never held.
             prism::Image displayed(expected.width, expected.height);
@@ -385,7 +407,6 @@ Row compare_image(const Arguments& arguments, const prism::scene::Camera& camera
             expected_bytes =
                 prism::to_8bit(prism::downsample_box(displayed, rendered.image.width, rendered.image.height));
         }
-        const std::vector<std::uint8_t> actual = prism::to_8bit(rendered.image);
         const double psnr = prism::psnr(actual, expected_bytes);
         row.psnr = std::isinf(psnr) ? "inf" : fixed(psnr, 2);
         row.off = fixed(100.0 * prism::share_off_by_more_than(actual, expected_bytes, 8), 2);

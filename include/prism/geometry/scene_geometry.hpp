@@ -62,14 +62,17 @@ public:
             meshes_.emplace_back(mesh);
             add_instance(Kind::mesh, std::uint32_t(meshes_.size() - 1), mesh.material, mesh.transform,
                          meshes_.back().bounds(), mesh.textures, mesh.motion);
+            emitted_.emplace_back(mesh.radiance);
         }
         for (const auto& instance : scene.mesh_instances)
             add_instance(Kind::mesh, std::uint32_t(instance.base_mesh), instance.material, instance.transform,
                          meshes_[instance.base_mesh].bounds(), instance.textures, instance.motion);
+        for (const auto& instance : scene.mesh_instances) emitted_.emplace_back(scene.meshes[instance.base_mesh].radiance);
         for (const auto& sphere : scene.spheres) {
             spheres_.push_back({Vec3<Real>(sphere.center), Real(sphere.radius)});
             add_instance(Kind::sphere, std::uint32_t(spheres_.size() - 1), sphere.material, sphere.transform,
                          spheres_.back().bounds(), sphere.textures, sphere.motion);
+            emitted_.emplace_back(sphere.radiance);
         }
         // Planes are unbounded, so they stay outside the top-level index and are tested always.
         for (const auto& plane : scene.planes) {
@@ -100,6 +103,10 @@ public:
         for (const auto& mesh : meshes_) total += mesh.accelerator_bytes();
         return total;
     }
+
+    // The radiance object `object` (Hit::object) emits from its surface: a LightMesh's or
+    // LightSphere's (and a LightMesh instance's), zero for every other object and for planes.
+    Vec3<Real> emitted(std::uint32_t object) const { return object < emitted_.size() ? emitted_[object] : Vec3<Real>(0); }
 
     // Closest hit in (ray.t_min, ray.t_max]; on a hit, ray.t_max becomes the hit distance.
     // `Culling` names the surfaces skipped when the ray meets them from behind
@@ -403,6 +410,7 @@ private:
     // Each object's texture indices; entry 0 is the empty list that untextured objects share.
     std::vector<std::vector<std::uint32_t>> texture_lists_{1};
     std::vector<Instance> instances_;
+    std::vector<Vec3<Real>> emitted_;  // per instance, in instances_'s order
     std::vector<InstanceTransforms<Real>> transforms_;
     Index top_;
 };

@@ -116,4 +116,31 @@ inline Image downsample_box(const Image& source, int width, int height) {
     return target;
 }
 
+// Comparing radiance (HDR references): one display transform for both images, fixed by the
+// reference alone. Radiance times `exposure` is clamped to [0, 1] and gamma-encoded (1/2.2) to
+// 8 bits, so dark regions weigh as in a PNG. A path-traced reference's own tone-mapped PNG
+// takes its key from its noisy log-average (the mean of log Y drops with noise), so a
+// converged render tone-mapped by its own statistics is exposed differently; comparing radiance
+// under the reference's exposure does not charge that to the render.
+inline std::vector<std::uint8_t> display_8bit(const Image& radiance, double exposure) {
+    std::vector<std::uint8_t> bytes;
+    bytes.reserve(radiance.pixels.size() * 3);
+    for (const glm::vec3& pixel : radiance.pixels)
+        for (int c = 0; c < 3; ++c) {
+            const double value = std::clamp(double(pixel[c]) * exposure, 0.0, 1.0);
+            bytes.push_back(std::uint8_t(std::lround(255.0 * std::pow(value, 1.0 / 2.2))));
+        }
+    return bytes;
+}
+
+// The exposure that brings the reference's mean luminance (Rec. 709) to 0.18, the photographic
+// middle grey; 1 for a black image.
+inline double mean_grey_exposure(const Image& reference) {
+    double sum = 0.0;
+    for (const glm::vec3& pixel : reference.pixels)
+        sum += 0.2126 * double(pixel.r) + 0.7152 * double(pixel.g) + 0.0722 * double(pixel.b);
+    const double mean = reference.pixels.empty() ? 0.0 : sum / double(reference.pixels.size());
+    return mean > 0.0 && std::isfinite(mean) ? 0.18 / mean : 1.0;
+}
+
 }  // namespace prism

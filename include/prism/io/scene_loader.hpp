@@ -380,6 +380,7 @@ private:
         for (const Element& child : element.children)
             if (child.name == "Tonemap") camera.tonemaps.push_back(read_tonemap(child));
         check_tonemap_names(element, camera);
+        camera.renderer = read_renderer(element);
 
         const glm::dmat4 transform = transformation_of(element);
         camera.position = transform_point(transform, camera.position);
@@ -390,8 +391,40 @@ private:
 
         note_unsupported_children(element, {"Position", "Gaze", "GazePoint", "Up", "NearPlane", "NearDistance", "FovY",
                                             "ImageResolution", "ImageName", "NumSamples", "ApertureSize",
-                                            "FocusDistance", "Filter", "Transformations", "Tonemap"});
+                                            "FocusDistance", "Filter", "Transformations", "Tonemap", "Renderer",
+                                            "RendererParams"});
         scene_.cameras.push_back(std::move(camera));
+    }
+
+    // <Renderer>: the course's ray tracer when absent, or PathTracing with the words of
+    // <RendererParams>. A renderer prism does not implement (ProgressivePhotonMapping) is a
+    // fault, never rendered as something else.
+    scene::RendererParams read_renderer(const Element& camera) {
+        scene::RendererParams params;
+        const Element* renderer = camera.child("Renderer");
+        const Element* words = camera.child("RendererParams");
+        if (renderer == nullptr) {
+            if (words != nullptr) fail(*words, "<RendererParams> without a <Renderer>");
+            return params;
+        }
+        const std::string_view name = trim(renderer->text);
+        if (name == "PathTracing") params.path_tracing = true;
+        else if (name != "RayTracing")
+            fail(*renderer, "prism does not implement the renderer " + in_quotes(std::string(name)) +
+                                " (it renders PathTracing and, without <Renderer>, the course's ray tracer)");
+        if (words == nullptr) return params;
+        if (!params.path_tracing) fail(*words, "<RendererParams> apply to PathTracing only");
+        for (std::string_view word : split_words(words->text)) {
+            if (word == "NextEventEstimation") params.next_event_estimation = true;
+            else if (word == "ImportanceSampling") params.importance_sampling = true;
+            else if (word == "RussianRoulette") params.russian_roulette = true;
+            else if (word == "MultipleImportanceSampling") params.multiple_importance = params.next_event_estimation = true;
+            else
+                fail(*words, "unknown path tracing parameter " + in_quotes(std::string(word)) +
+                                 " (expected NextEventEstimation, ImportanceSampling, RussianRoulette or "
+                                 "MultipleImportanceSampling)");
+        }
+        return params;
     }
 
     // <Tonemap><TMO>Photographic</TMO><TMOOptions>key burn%</TMOOptions><Saturation>
@@ -672,7 +705,8 @@ private:
                                       std::uint32_t(triangle[2] + base)});
     }
 
-    void read_mesh(const Element& element) {
+    // A <LightMesh> is a Mesh with a <Radiance> (emitting = true).
+    void read_mesh(const Element& element, bool emitting = false) {
         scene::Mesh mesh;
         mesh.id = id_of(element);
         mesh.shading = shading_of(element);
@@ -703,7 +737,9 @@ private:
         finish_mesh(mesh);
         mesh.textures = textures_.textures_of(element);
         mesh.motion = motion_of(element);
-        note_unsupported_children(element, {"Material", "Transformations", "Faces", "Textures", "Texture", "MotionBlur"});
+        if (emitting) mesh.radiance = radiance_of(element);
+        note_unsupported_children(element, {"Material", "Transformations", "Faces", "Textures", "Texture", "MotionBlur",
+                                            emitting ? "Radiance" : "Faces"});
         if (!mesh_indices_.emplace(mesh.id, scene_.meshes.size()).second) ambiguous_mesh_ids_.insert(mesh.id);
         scene_.meshes.push_back(std::move(mesh));
     }
@@ -745,7 +781,8 @@ private:
         if (mesh.uvs.size() != mesh.positions.size()) mesh.uvs.clear();
     }
 
-    void read_sphere(const Element& element) {
+    // A <LightSphere> is a Sphere with a <Radiance> (emitting = true).
+    void read_sphere(const Element& element, bool emitting = false) {
         scene::Sphere sphere;
         sphere.id = id_of(element);
         sphere.material = material_of(required(element, "Material"));
@@ -756,9 +793,18 @@ private:
         if (!(sphere.radius > 0.0)) fail(radius, "the radius must be positive");
         sphere.textures = textures_.textures_of(element);
         sphere.motion = motion_of(element);
-        note_unsupported_children(element,
-                                  {"Material", "Transformations", "Center", "Radius", "Textures", "Texture", "MotionBlur"});
+        if (emitting) sphere.radiance = radiance_of(element);
+        note_unsupported_children(element, {"Material", "Transformations", "Center", "Radius", "Textures", "Texture",
+                                            "MotionBlur", emitting ? "Radiance" : "Center"});
         scene_.spheres.push_back(std::move(sphere));
+    }
+
+    // An object light's <Radiance>: three non-negative numbers.
+    scene::Vec3 radiance_of(const Element& element) {
+        const Element& radiance = required(element, "Radiance");
+        const scene::Vec3 value = vector3(radiance);
+        if (glm::any(glm::lessThan(value, scene::Vec3(0.0)))) fail(radiance, "the radiance must not be negative");
+        return value;
     }
 
     void read_plane(const Element& element) {
@@ -781,6 +827,8 @@ private:
             if (element.name == "Mesh") read_mesh(element);
             else if (element.name == "Triangle") read_triangle(element);
             else if (element.name == "Sphere") read_sphere(element);
+            else if (element.name == "LightMesh") read_mesh(element, true);
+            else if (element.name == "LightSphere") read_sphere(element, true);
             else if (element.name == "Plane") read_plane(element);
             else if (element.name == "MeshInstance") instances.push_back(&element);
             else note_unsupported(element);

@@ -19,6 +19,11 @@ struct LightSample {
     Vec3<Real> direction{0};  // unit, from the shading point towards the light
     Real distance = 0;        // shadow rays test (epsilon, distance)
     Vec3<Real> radiance{0};   // arriving at the point, before the cosine and the BRDF
+    // The solid-angle density the direction was drawn with, for lights that rays can also hit
+    // (object lights), so an integrator can weigh this sample against a BRDF sample (multiple
+    // importance sampling). Zero for lights no ray can hit: points, spots, directions, and the
+    // lights prism samples only from the shading point (area, environment).
+    Real pdf = 0;
 };
 
 // Where a light is seen from: the shading point and its unit normal on the side the ray came

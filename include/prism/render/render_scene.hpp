@@ -8,8 +8,11 @@
 #include <prism/light/area_light.hpp>
 #include <prism/light/directional_light.hpp>
 #include <prism/light/environment_light.hpp>
+#include <prism/light/light_mesh.hpp>
+#include <prism/light/light_sphere.hpp>
 #include <prism/light/point_light.hpp>
 #include <prism/light/spot_light.hpp>
+#include <prism/render/path_tracer.hpp>
 #include <prism/render/renderer.hpp>
 #include <prism/scene/features.hpp>
 #include <prism/scene/needs.hpp>
@@ -119,7 +122,7 @@ inline Choice choose_precision(const scene::Scene& scene, const RenderOptions& o
 // saves. A light type, feature or integrator is added to the shipped list below, and the
 // dispatcher takes the first Config of a precision's list that covers the scene.
 using PointLightSet = Lights<PointLight>;
-using AllLightSet = Lights<PointLight, DirectionalLight, SpotLight, AreaLight, EnvironmentLight>;
+using AllLightSet = Lights<PointLight, DirectionalLight, SpotLight, AreaLight, EnvironmentLight, LightMesh, LightSphere>;
 inline constexpr Features no_features{};
 inline constexpr Features all_features{.textures = true, .motion_blur = true};
 
@@ -140,11 +143,14 @@ template <> struct PrecisionPolicy<Precision::double_all> {
 
 template <class... Configs> struct ConfigList {};
 
-// The Configs render_scene compiles for a precision, the most specialised first.
+// The Configs render_scene compiles for a precision, the most specialised first. The path
+// tracer comes only with the complete light set and features: one more renderer per precision,
+// not one per light set (DESIGN.md), and a scene without a path-traced camera never runs it.
 template <Precision P, class Real = typename PrecisionPolicy<P>::Real,
           class Acceleration = typename PrecisionPolicy<P>::Acceleration>
 using ShippedConfigs = ConfigList<Config<Real, Acceleration, PointLightSet, no_features, Whitted>,
-                                  Config<Real, Acceleration, AllLightSet, all_features, Whitted>>;
+                                  Config<Real, Acceleration, AllLightSet, all_features, Whitted>,
+                                  Config<Real, Acceleration, AllLightSet, all_features, PathTracer>>;
 
 // The image size a camera renders at under RenderOptions::resolution_scale (at least 1 pixel).
 inline int scaled_size(int size, double scale) { return std::max(1, int(std::lround(size * scale))); }
@@ -257,6 +263,7 @@ inline std::vector<CameraImage> render_scene(
         << " (" << choice.reason << "); "
         << (beyond.empty() ? "point lights only, no textures or motion blur"
                            : "all light types, textures and motion blur (the scene has " + beyond + ")")
+        << (needs.path_tracing ? "; path tracing (a camera asks for PathTracing)" : "")
         << "; rays leave surfaces by "
         << (*chosen.ray_offset == RayOffset::error_bound ? "their error bounds" : "the ShadowRayEpsilon") << " ("
         << offset_reason << ")\n";

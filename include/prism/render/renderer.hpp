@@ -75,7 +75,7 @@ public:
                               std::vector<Vec2<Real>> scratch;
                               for (int y = tile.rows().begin(); y < tile.rows().end(); ++y)
                                   for (int x = tile.cols().begin(); x < tile.cols().end(); ++x)
-                                      image(x, y) = pixel(lens, camera.filter, count, x, y, samples, scratch);
+                                      image(x, y) = pixel(lens, camera, count, x, y, samples, scratch);
                               on_tile(int(tile.rows().size() * tile.cols().size()));
                           });
         return image;
@@ -90,13 +90,17 @@ public:
     }
 
 private:
-    glm::vec3 pixel(const ThinLensCamera<Real>& lens, scene::PixelFilter filter, int count, int x, int y,
+    glm::vec3 pixel(const ThinLensCamera<Real>& lens, const scene::Camera& camera, int count, int x, int y,
                     std::vector<CameraSample<Real>>& samples, std::vector<Vec2<Real>>& scratch) const {
+        const scene::PixelFilter filter = camera.filter;
         Random random = Random::for_pixel(x, y, settings_.seed);
         camera_samples(count, random, samples, scratch);
         typename Integrator::CameraPath path{
             random, Vec2<Real>((Real(x) + Real(0.5)) / Real(lens.width()), (Real(y) + Real(0.5)) / Real(lens.height())),
             lens.pixel_spread()};
+        // Integrators that render cameras differently (the path tracer's RendererParams) learn
+        // the camera's choice here.
+        if constexpr (requires { path.renderer; }) path.renderer = camera.renderer;
         Vec3<Real> sum(0);
         Real weights = 0;
         for (const CameraSample<Real>& sample : samples) {

@@ -119,7 +119,8 @@ private:
         const bool inside_medium = !front_face && material.type == scene::MaterialType::dielectric;
         Vec3<Real> color(0);
         if (!inside_medium) {
-            color = material.ambient * ambient_light_;
+            // Object lights (LightMesh, LightSphere) are seen by every ray that finds them.
+            color = geometry_.emitted(hit.object) + material.ambient * ambient_light_;
             color += direct_lighting(point, normal, -d, material, random);
         }
 
@@ -259,7 +260,8 @@ struct Whitted {
     template <Scalar Real, class Geometry, class LightSetT, class Textures, class Environment>
     using Type = WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment>;
 
-    static constexpr bool covers(const scene::Needs&) { return true; }
+    // Not scenes with a path-traced camera: those need the PathTracer policy.
+    static constexpr bool covers(const scene::Needs& needs) { return !needs.path_tracing; }
 };
 
 }  // namespace prism

@@ -16,7 +16,8 @@ namespace prism::scene {
 
 // One bit per light type of the scene description; each prism light type names its kind, and a
 // light set covers the union of its types' kinds.
-enum class LightKind : std::uint32_t { point, directional, spot, area, environment, count };
+// `object`: LightMesh and LightSphere, geometry that emits.
+enum class LightKind : std::uint32_t { point, directional, spot, area, environment, object, count };
 
 using LightKinds = std::uint32_t;  // a set of LightKind bits
 
@@ -29,6 +30,7 @@ inline const char* name(LightKind kind) {
         case LightKind::spot: return "spot lights";
         case LightKind::area: return "area lights";
         case LightKind::environment: return "environment lights";
+        case LightKind::object: return "object lights (LightMesh, LightSphere)";
         case LightKind::count: break;
     }
     return "?";
@@ -38,6 +40,9 @@ struct Needs {
     LightKinds lights = 0;
     bool textures = false;
     bool motion_blur = false;
+    // Some camera asks for <Renderer>PathTracing</Renderer>: an integrator policy states
+    // whether it covers this (render/integrator.hpp); light sets and features do not.
+    bool path_tracing = false;
 
     // Whether `covered` (what a renderer can do, stated as needs) includes all of these.
     constexpr bool within(const Needs& covered) const {
@@ -70,6 +75,11 @@ inline LightKinds light_kinds(const Scene& scene) {
     add(!scene.spot_lights.empty(), LightKind::spot);
     add(!scene.area_lights.empty(), LightKind::area);
     add(!scene.environment_lights.empty(), LightKind::environment);
+    const auto emits = [](const auto& objects) {
+        return std::any_of(objects.begin(), objects.end(),
+                           [](const auto& object) { return object.radiance != glm::dvec3(0.0); });
+    };
+    add(emits(scene.meshes) || emits(scene.spheres), LightKind::object);
     return kinds;
 }
 
@@ -86,6 +96,8 @@ inline Needs measure_needs(const Scene& scene) {
     needs.lights = light_kinds(scene);
     needs.textures = !scene.textures.empty();
     needs.motion_blur = has_moving_objects(scene);
+    needs.path_tracing = std::any_of(scene.cameras.begin(), scene.cameras.end(),
+                                     [](const Camera& camera) { return camera.renderer.path_tracing; });
     return needs;
 }
 

@@ -39,6 +39,18 @@ struct Tonemap {
     std::string extension;
 };
 
+// How a camera's image is computed: the course's recursive ray tracer, or path tracing
+// (<Renderer>PathTracing</Renderer>) with the <RendererParams> the camera lists.
+// multiple_importance is prism's own word (MultipleImportanceSampling), beyond the course: it
+// weights next-event and BRDF samples of object lights by the power heuristic.
+struct RendererParams {
+    bool path_tracing = false;
+    bool next_event_estimation = false;
+    bool importance_sampling = false;
+    bool russian_roulette = false;
+    bool multiple_importance = false;
+};
+
 // A pinhole camera in the course's "Gaze + NearPlane" form. The loader turns `type="lookAt"`
 // cameras (GazePoint, FovY) and camera transformations into this form, so the renderer knows
 // a single camera model.
@@ -64,6 +76,7 @@ struct Camera {
     // One LDR image per entry, all from the one HDR render (image/tonemap.hpp); none: a .png
     // is the course's clamp of radiance to 0..255.
     std::vector<Tonemap> tonemaps;
+    RendererParams renderer;
 };
 
 struct PointLight {
@@ -214,6 +227,9 @@ struct Mesh {
     Mat4 transform{1.0};  // object to world
     std::vector<std::size_t> textures;  // indices into Scene::textures, in the file's order
     Vec3 motion{0.0};  // MotionBlur: the world-space translation over the shutter interval
+    // A <LightMesh>'s Radiance, emitted from both faces of every triangle (and by its
+    // instances); zero for an ordinary mesh.
+    Vec3 radiance{0.0};
 };
 
 struct Sphere {
@@ -224,6 +240,7 @@ struct Sphere {
     Mat4 transform{1.0};
     std::vector<std::size_t> textures;
     Vec3 motion{0.0};
+    Vec3 radiance{0.0};  // a <LightSphere>'s Radiance, emitted from its surface; zero otherwise
 };
 
 struct Plane {

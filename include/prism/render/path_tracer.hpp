@@ -1,0 +1,300 @@
+// Path tracing (Kajiya 1986), as the course's <Renderer>PathTracing</Renderer> asks for it, with
+// the <RendererParams> each camera lists:
+// - ImportanceSampling: directions drawn from the material's BRDF (material/brdf.hpp: its
+//   specular lobe or the cosine-weighted hemisphere) rather than uniformly over the hemisphere;
+// - NextEventEstimation: every light sampled at every non-specular vertex (Whitted-style shadow
+//   rays), and emission that a BRDF-sampled ray then finds not counted again;
+// - RussianRoulette: a path continues with probability q = min(1, max throughput) and its
+//   throughput is divided by q: unbiased (Arvo and Kirk 1990; pbrt-v4 sec. 14.5.3);
+// - MultipleImportanceSampling (prism's own word, beyond the course): object lights reached by
+//   next-event and by BRDF samples are weighed by the power heuristic (Veach and Guibas 1995;
+//   Veach's thesis sec. 9.2), so neither small bright lights nor glossy surfaces are noisy.
+// A path has at most MaxRecursionDepth bounces after the camera's hit, whatever the parameters,
+// so every combination estimates the same image (Russian roulette only thins paths within that
+// bound). Mirrors, conductors and dielectrics scatter as in the course's ray tracer, choosing
+// reflection or refraction by the Fresnel weight. The loop is iterative: the path's length is
+// bounded by the depth, never by native recursion.
+// Cameras without <Renderer>PathTracing</Renderer> in the same scene render with the course's
+// ray tracer, which this integrator holds.
+#pragma once
+
+#include <prism/light/environment_light.hpp>
+#include <prism/light/light_mesh.hpp>
+#include <prism/light/light_sphere.hpp>
+#include <prism/material/brdf.hpp>
+#include <prism/render/whitted_integrator.hpp>
+#include <prism/sampling/hemisphere.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace prism {
+
+namespace path_tracing {
+
+// Veach's power heuristic with exponent 2, for one sample of each strategy.
+template <Scalar Real>
+Real power_heuristic(Real chosen, Real other) {
+    const Real a = chosen * chosen, b = other * other;
+    return a + b > 0 ? a / (a + b) : Real(0);
+}
+
+}  // namespace path_tracing
+
+template <Scalar Real, class Geometry, class LightSetT, class Textures = NoTextures<Real>,
+          class Environment = NoEnvironment<Real>>
+class PathTracerIntegrator {
+public:
+    using RayTracer = WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment>;
+
+    PathTracerIntegrator(const Geometry& geometry, const LightSetT& lights, const std::vector<Material<Real>>& materials,
+                         const Textures& textures, const Environment& environment, const Vec3<Real>& ambient_light,
+                         const Vec3<Real>& background, const IntegratorSettings& settings)
+        : whitted_(geometry, lights, materials, textures, environment, ambient_light, background, settings),
+          geometry_(geometry), lights_(lights), materials_(materials), textures_(textures), environment_(environment),
+          background_(background), settings_(settings), epsilon_(Real(settings.shadow_ray_epsilon)) {
+        // Which object light each emitting object is, for the density of reaching it by
+        // next-event estimation (multiple importance sampling).
+        emitters_.assign(geometry.instance_count(), Emitter{});
+        if (const auto* meshes = lights.template of_type<LightMesh>())
+            for (std::size_t i = 0; i < meshes->size(); ++i)
+                if ((*meshes)[i].object < emitters_.size()) emitters_[(*meshes)[i].object] = {Emitter::mesh, std::uint32_t(i)};
+        if (const auto* spheres = lights.template of_type<LightSphere>())
+            for (std::size_t i = 0; i < spheres->size(); ++i)
+                if ((*spheres)[i].object < emitters_.size())
+                    emitters_[(*spheres)[i].object] = {Emitter::sphere, std::uint32_t(i)};
+    }
+
+    struct CameraPath {
+        Random& random;
+        Vec2<Real> pixel_uv;
+        Real spread = 0;
+        scene::RendererParams renderer{};  // the camera's; without path_tracing, the ray tracer renders
+    };
+
+    Vec3<Real> radiance(const Ray<Real>& ray, CameraPath& path) const {
+        if (!path.renderer.path_tracing) {
+            typename RayTracer::CameraPath traced{path.random, path.pixel_uv, path.spread};
+            return whitted_.radiance(ray, traced);
+        }
+        return trace(ray, path);
+    }
+
+private:
+    struct Emitter {
+        enum Type : std::uint8_t { none, mesh, sphere } type = none;
+        std::uint32_t index = 0;
+    };
+
+    Vec3<Real> trace(Ray<Real> ray, CameraPath& path) const {
+        const scene::RendererParams& params = path.renderer;
+        Random& random = path.random;
+        Vec3<Real> color(0), throughput(1);
+        // Whether emission found by this ray counts in full: at the camera, after a specular
+        // bounce, or without next-event estimation. Otherwise it was already counted by the
+        // light sample at the previous vertex (or is weighed against it, with MIS).
+        bool count_emission = true;
+        Real scatter_pdf = 0;        // the solid-angle density of the last BRDF-sampled direction
+        Vec3<Real> previous_position(0);
+        Real travelled = 0;
+        for (int depth = 0;; ++depth) {
+            Hit<Real> hit;
+            const bool found = intersect(ray, depth, hit);
+            if (!found) {
+                color += throughput * escaped(ray.direction, depth, count_emission, path.pixel_uv);
+                break;
+            }
+            SurfacePoint<Real> point = geometry_.surface(ray, hit);
+            Material<Real> material = materials_[point.material];
+            travelled += hit.t;
+            const RayCone<Real> cone{travelled * path.spread, std::abs(glm::dot(ray.direction, point.shading_normal))};
+            if (const std::optional<Vec3<Real>> unshaded = textures_.apply(point, material, cone)) {
+                color += throughput * *unshaded;
+                break;
+            }
+            const Vec3<Real>& d = ray.direction;
+            const bool front_face = glm::dot(point.geometric_normal, d) < 0;
+            const Vec3<Real> normal = front_face ? point.shading_normal : -point.shading_normal;
+
+            const Vec3<Real> emitted = geometry_.emitted(hit.object);
+            if (emitted != Vec3<Real>(0)) {
+                if (count_emission) color += throughput * emitted;
+                else if (params.multiple_importance)
+                    color += throughput * emitted *
+                             path_tracing::power_heuristic(scatter_pdf,
+                                                           light_pdf(hit.object, previous_position, point));
+            }
+            if (depth >= settings_.max_recursion_depth) break;
+
+            // Beer's law for a path that crossed a dielectric's inside to reach this point.
+            if (!front_face && material.type == scene::MaterialType::dielectric)
+                throughput *= glm::exp(-material.absorption_coefficient * hit.t);
+
+            Vec3<Real> direction;
+            if (material.type != scene::MaterialType::blinn_phong) {
+                direction = specular_direction(d, normal, front_face, material, random, throughput);
+                count_emission = true;
+            } else {
+                const Vec3<Real> wo = -d;
+                if (params.next_event_estimation)
+                    color += throughput * direct_lighting(point, normal, wo, material, params, random);
+                Real density;
+                Vec3<Real> value;
+                if (params.importance_sampling) {
+                    const BrdfSample<Real> sample = sample_brdf(material, normal, wo, random.uniform2<Real>());
+                    direction = sample.direction;
+                    density = sample.pdf;
+                    value = sample.value;
+                } else {
+                    direction = sample_uniform_hemisphere(normal, random.uniform2<Real>());
+                    density = 1 / (2 * pi<Real>);
+                    value = evaluate_brdf(material, normal, direction, wo);
+                }
+                const Real cos_theta = glm::dot(normal, direction);
+                if (!(density > 0) || !(cos_theta > 0)) break;
+                throughput *= value * (cos_theta / density);
+                scatter_pdf = density;
+                count_emission = !params.next_event_estimation;
+            }
+            if (throughput == Vec3<Real>(0)) break;
+            if (params.russian_roulette && depth > 0) {
+                const Real survival = std::min(Real(1), std::max({throughput.x, throughput.y, throughput.z}));
+                if (random.uniform<Real>() >= survival) break;
+                throughput /= survival;
+            }
+            previous_position = point.position;
+            ray = leaving(point, normal, direction, ray.time);
+        }
+        return color;
+    }
+
+    // The closest hit, camera rays skipping back faces as the ray tracer does
+    // (settings_.backface_culling), so both integrators see the same first surfaces.
+    bool intersect(Ray<Real>& ray, int depth, Hit<Real>& hit) const {
+        if (depth == 0) {
+            switch (settings_.backface_culling) {
+                case BackfaceCulling::none: break;
+                case BackfaceCulling::flat_triangles:
+                    return geometry_.template intersect<BackfaceCulling::flat_triangles>(ray, hit);
+                case BackfaceCulling::all: return geometry_.template intersect<BackfaceCulling::all>(ray, hit);
+            }
+        }
+        return geometry_.template intersect<BackfaceCulling::none>(ray, hit);
+    }
+
+    // Mirrors and conductors reflect; dielectrics reflect or refract, chosen by the Fresnel
+    // weight so that the throughput keeps its magnitude (the choice's probability cancels it).
+    Vec3<Real> specular_direction(const Vec3<Real>& d, const Vec3<Real>& normal, bool front_face,
+                                  const Material<Real>& material, Random& random, Vec3<Real>& throughput) const {
+        using scene::MaterialType;
+        const Real cos_incident = -glm::dot(d, normal);
+        Vec3<Real> reflected = d + 2 * cos_incident * normal;
+        if (material.roughness > 0) reflected = perturb(reflected, material.roughness, random.uniform2<Real>());
+        if (material.type == MaterialType::mirror) {
+            throughput *= material.mirror;
+            return reflected;
+        }
+        if (material.type == MaterialType::conductor) {
+            throughput *= material.mirror * fresnel_conductor(std::max(cos_incident, Real(0)), material.refraction_index,
+                                                              material.absorption_index);
+            return reflected;
+        }
+        const Real n1 = front_face ? Real(1) : material.refraction_index;
+        const Real n2 = front_face ? material.refraction_index : Real(1);
+        const Real ratio = n1 / n2;
+        const Real sin2_transmitted = ratio * ratio * (1 - cos_incident * cos_incident);
+        if (sin2_transmitted >= 1) return reflected;
+        const Real cos_transmitted = std::sqrt(1 - sin2_transmitted);
+        const Real fresnel = fresnel_dielectric(cos_incident, cos_transmitted, n1, n2);
+        if (random.uniform<Real>() < fresnel) return reflected;
+        Vec3<Real> transmitted = glm::normalize(ratio * d + (ratio * cos_incident - cos_transmitted) * normal);
+        if (material.roughness > 0) transmitted = perturb(transmitted, material.roughness, random.uniform2<Real>());
+        if (material.transparency != Vec3<Real>(0)) throughput *= material.transparency;
+        return transmitted;
+    }
+
+    // Next-event estimation: one sample of every light, as the course's ray tracer takes them.
+    Vec3<Real> direct_lighting(const SurfacePoint<Real>& point, const Vec3<Real>& normal, const Vec3<Real>& wo,
+                               const Material<Real>& material, const scene::RendererParams& params,
+                               Random& random) const {
+        Vec3<Real> color(0);
+        lights_.for_each([&](const auto& light) {
+            const LightSample<Real> sample = light.sample({point.position, normal}, random.uniform2<Real>());
+            const Real cos_light = glm::dot(normal, sample.direction);
+            if (cos_light <= 0 || sample.radiance == Vec3<Real>(0)) return;
+            Ray<Real> shadow = leaving(point, normal, sample.direction, point.time);
+            if (!std::isinf(sample.distance)) {
+                const Vec3<Real> target = point.position + sample.direction * sample.distance;
+                shadow.direction = glm::normalize(target - shadow.origin);
+                // An object light's own surface is at the far end: stop short of it.
+                shadow.t_max = glm::length(target - shadow.origin) * (1 - Real(1e-4));
+            }
+            if (geometry_.occluded(shadow)) return;
+            Vec3<Real> contribution = evaluate_brdf(material, normal, sample.direction, wo) * cos_light * sample.radiance;
+            if (params.multiple_importance && sample.pdf > 0)
+                contribution *= path_tracing::power_heuristic(sample.pdf, scatter_density(params, material, normal, sample.direction, wo));
+            color += contribution;
+        });
+        return color;
+    }
+
+    // The solid-angle density with which the path's next direction is drawn: from the BRDF with
+    // ImportanceSampling, uniformly over the hemisphere without.
+    static Real scatter_density(const scene::RendererParams& params, const Material<Real>& material,
+                                const Vec3<Real>& normal, const Vec3<Real>& wi, const Vec3<Real>& wo) {
+        if (params.importance_sampling) return brdf_pdf(material, normal, wi, wo);
+        return glm::dot(normal, wi) > 0 ? 1 / (2 * pi<Real>) : Real(0);
+    }
+
+    // The density next-event estimation gives to reaching `point` on object `object` from `from`.
+    Real light_pdf(std::uint32_t object, const Vec3<Real>& from, const SurfacePoint<Real>& point) const {
+        if (object >= emitters_.size()) return 0;
+        const Emitter& emitter = emitters_[object];
+        if (const auto* meshes = lights_.template of_type<LightMesh>(); meshes && emitter.type == Emitter::mesh)
+            return (*meshes)[emitter.index].pdf(from, point.position, point.geometric_normal);
+        if (const auto* spheres = lights_.template of_type<LightSphere>(); spheres && emitter.type == Emitter::sphere)
+            return (*spheres)[emitter.index].pdf(from, point.position, point.geometric_normal);
+        return 0;
+    }
+
+    // A ray that meets nothing: the background at the camera; the environment after a specular
+    // bounce or without next-event estimation (which otherwise samples it).
+    Vec3<Real> escaped(const Vec3<Real>& direction, int depth, bool count_emission, const Vec2<Real>& pixel_uv) const {
+        if (depth == 0) {
+            if (const std::optional<Vec3<Real>> texture = textures_.background(pixel_uv)) return *texture;
+            return environment_.present() ? environment_.radiance(direction) : background_;
+        }
+        return environment_.present() && count_emission ? environment_.radiance(direction) : Vec3<Real>(0);
+    }
+
+    Ray<Real> leaving(const SurfacePoint<Real>& point, const Vec3<Real>& normal, const Vec3<Real>& direction,
+                      Real time) const {
+        Ray<Real> ray{Vec3<Real>(0), direction, Real(0), infinity<Real>, time};
+        if (settings_.ray_offset == RayOffset::error_bound) ray.origin = geometry_.spawn_origin(point, direction);
+        else ray.origin = point.position + (glm::dot(direction, normal) >= 0 ? normal : -normal) * epsilon_;
+        return ray;
+    }
+
+    RayTracer whitted_;
+    const Geometry& geometry_;
+    const LightSetT& lights_;
+    const std::vector<Material<Real>>& materials_;
+    const Textures& textures_;
+    const Environment& environment_;
+    Vec3<Real> background_;
+    IntegratorSettings settings_;
+    Real epsilon_;
+    std::vector<Emitter> emitters_;  // per object of the geometry
+};
+
+// The Config policy that path traces the cameras asking for it (and ray traces the others).
+struct PathTracer {
+    template <Scalar Real, class Geometry, class LightSetT, class Textures, class Environment>
+    using Type = PathTracerIntegrator<Real, Geometry, LightSetT, Textures, Environment>;
+
+    static constexpr bool covers(const scene::Needs&) { return true; }
+};
+
+}  // namespace prism

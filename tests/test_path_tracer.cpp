@@ -1,0 +1,236 @@
+// The path tracer: a furnace with an analytic answer under every RendererParams combination,
+// every combination converging to the same image within its noise, images identical at any
+// thread count, and dispatch: the path tracer only for scenes with a path-traced camera.
+#include "temporary_folder.hpp"
+
+#include <prism/io/load.hpp>
+#include <prism/render/path_tracer.hpp>
+#include <prism/render/render_scene.hpp>
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace scene = prism::scene;
+using prism_test::TemporaryFolder;
+
+template <class Real>
+using PathConfig = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::AllLightSet, prism::all_features,
+                                 prism::PathTracer>;
+
+// Every combination of the course's three words, and MIS (which implies next-event estimation).
+std::vector<scene::RendererParams> all_params() {
+    std::vector<scene::RendererParams> list;
+    for (int bits = 0; bits < 8; ++bits)
+        list.push_back({true, (bits & 1) != 0, (bits & 2) != 0, (bits & 4) != 0, false});
+    list.push_back({true, true, true, false, true});
+    list.push_back({true, true, false, true, true});
+    return list;
+}
+
+std::string describe(const scene::RendererParams& p) {
+    std::ostringstream out;
+    out << (p.next_event_estimation ? "NEE " : "") << (p.importance_sampling ? "IS " : "")
+        << (p.russian_roulette ? "RR " : "") << (p.multiple_importance ? "MIS" : "");
+    return out.str();
+}
+
+scene::Camera camera_at(const glm::dvec3& position, const glm::dvec3& gaze, int size, int samples) {
+    scene::Camera camera;
+    camera.position = position;
+    camera.gaze = gaze;
+    camera.up = {0, 1, 0};
+    camera.near_left = camera.near_bottom = -0.5;
+    camera.near_right = camera.near_top = 0.5;
+    camera.width = camera.height = size;
+    camera.num_samples = samples;
+    camera.image_name = "out.exr";
+    return camera;
+}
+
+// A closed cube (side 2, centred at the origin) that emits Le = 1 everywhere and reflects
+// diffusely with albedo rho = 1/2 (a normalised ModifiedPhong with ks = 0: kd / pi). Every point sees the same
+// radiance, so L = Le (1 + rho + ... + rho^D) after at most D bounces: 1.875 for D = 3.
+scene::Scene furnace() {
+    scene::Scene world;
+    world.max_recursion_depth = 3;
+    scene::Material material;
+    material.diffuse = {0.5, 0.5, 0.5};
+    material.brdf = scene::Brdf{"1", scene::BrdfModel::modified_phong, 10.0, true, false};
+    world.materials.push_back(material);
+    scene::Mesh cube;
+    for (int i = 0; i < 8; ++i) cube.positions.push_back({i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1});
+    cube.triangles = {{0, 1, 3}, {0, 3, 2}, {4, 7, 5}, {4, 6, 7}, {0, 4, 5}, {0, 5, 1},
+                      {2, 3, 7}, {2, 7, 6}, {0, 2, 6}, {0, 6, 4}, {1, 5, 7}, {1, 7, 3}};
+    cube.radiance = {1, 1, 1};
+    world.meshes.push_back(cube);
+    world.cameras.push_back(camera_at({0.1, 0.2, 0.3}, {0.3, -0.2, -1}, 8, 1024));
+    return world;
+}
+
+double mean_of(const prism::Image& image) {
+    double sum = 0;
+    for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x) sum += (image(x, y).r + image(x, y).g + image(x, y).b) / 3.0;
+    return sum / (image.width * image.height);
+}
+
+// A small Cornell box: white floor, back wall and ceiling, a red left and a green right wall
+// (normalised diffuse), a glossy sphere (normalised ModifiedBlinnPhong), a LightMesh square below the ceiling and a small LightSphere; a point light
+// too, which only next-event estimation can see, so it is left out here (all combinations must
+// estimate the same image).
+const char* const cornell_xml = R"(<Scene>
+    <MaxRecursionDepth>3</MaxRecursionDepth>
+    <Cameras><Camera id="1">
+        <Position>0 0 3.5</Position><Gaze>0 0 -1</Gaze><Up>0 1 0</Up>
+        <NearPlane>-0.5 0.5 -0.5 0.5</NearPlane><NearDistance>1.2</NearDistance>
+        <ImageResolution>8 8</ImageResolution><ImageName>out.exr</ImageName>
+        <NumSamples>256</NumSamples>
+        <Renderer>PathTracing</Renderer>
+    </Camera></Cameras>
+    <BRDFs>
+        <ModifiedPhong id="1" normalized="true"><Exponent>1</Exponent></ModifiedPhong>
+        <ModifiedBlinnPhong id="2" normalized="true"><Exponent>20</Exponent></ModifiedBlinnPhong>
+    </BRDFs>
+    <Materials>
+        <Material id="1" BRDF="1"><DiffuseReflectance>0.8 0.8 0.8</DiffuseReflectance></Material>
+        <Material id="2" BRDF="1"><DiffuseReflectance>0.8 0.2 0.2</DiffuseReflectance></Material>
+        <Material id="3" BRDF="1"><DiffuseReflectance>0.2 0.8 0.2</DiffuseReflectance></Material>
+        <Material id="4" BRDF="2"><DiffuseReflectance>0.5 0.5 0.5</DiffuseReflectance>
+            <SpecularReflectance>0.3 0.3 0.3</SpecularReflectance></Material>
+        <Material id="5"><DiffuseReflectance>0 0 0</DiffuseReflectance></Material>
+    </Materials>
+    <VertexData>
+        -1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1
+        -1 -1 1   1 -1 1   1 1 1   -1 1 1
+        -0.3 0.98 -0.3  0.3 0.98 -0.3  0.3 0.98 0.3  -0.3 0.98 0.3
+        0.4 -0.6 -0.2  -0.5 0.5 0.2
+    </VertexData>
+    <Objects>
+        <Mesh id="1"><Material>1</Material><Faces>1 2 6 1 6 5  1 4 3 1 3 2  4 8 7 4 7 3</Faces></Mesh>
+        <Mesh id="2"><Material>2</Material><Faces>1 5 8 1 8 4</Faces></Mesh>
+        <Mesh id="3"><Material>3</Material><Faces>2 3 7 2 7 6</Faces></Mesh>
+        <LightMesh id="4"><Material>5</Material><Radiance>6 6 6</Radiance><Faces>9 11 10 9 12 11</Faces></LightMesh>
+        <Sphere id="5"><Material>4</Material><Center>13</Center><Radius>0.4</Radius></Sphere>
+        <LightSphere id="6"><Material>5</Material><Center>14</Center><Radius>0.08</Radius>
+            <Radiance>40 30 20</Radiance></LightSphere>
+    </Objects>
+</Scene>)";
+
+}  // namespace
+
+TEST_CASE_TEMPLATE("PathTracer: a furnace renders its analytic radiance within 1% under every RendererParams", Real,
+                   float, double) {
+    scene::Scene world = furnace();
+    prism::RendererSettings settings;
+    settings.backface_culling = prism::BackfaceCulling::none;  // the camera is inside the cube
+    const prism::Renderer<PathConfig<Real>> renderer(world, settings);
+    for (const scene::RendererParams& params : all_params()) {
+        CAPTURE(describe(params));
+        scene::Camera camera = world.cameras[0];
+        camera.renderer = params;
+        CHECK(mean_of(renderer.render(camera)) == doctest::Approx(1.875).epsilon(0.01));
+    }
+    // Without path tracing, the ray tracer sees the emission and one bounce of direct light.
+    scene::Camera traced = world.cameras[0];
+    CHECK(mean_of(renderer.render(traced)) != doctest::Approx(1.875).epsilon(0.01));
+}
+
+TEST_CASE_TEMPLATE("PathTracer: every RendererParams combination converges to the same image, within its noise", Real,
+                   float, double) {
+    TemporaryFolder folder;
+    const scene::Scene world = prism::io::load_scene(folder.write("cornell.xml", cornell_xml));
+    // Each combination renders 6 independent images (seeds); the mean and its standard error per
+    // 4 x 4 block of pixels and channel are compared with the reference combination's
+    // (NEE + IS, the lowest noise): within 4.5 combined standard errors.
+    const int seeds = 6;
+    struct Estimate {
+        std::vector<double> mean, error;
+    };
+    const auto estimate = [&](const scene::RendererParams& params) {
+        std::vector<std::vector<double>> blocks;  // per seed
+        for (int s = 0; s < seeds; ++s) {
+            prism::RendererSettings settings;
+            settings.backface_culling = prism::BackfaceCulling::none;  // the box's walls face either way
+            settings.seed = std::uint64_t(s + 1);
+            const prism::Renderer<PathConfig<Real>> renderer(world, settings);
+            scene::Camera camera = world.cameras[0];
+            camera.renderer = params;
+            const prism::Image image = renderer.render(camera);
+            std::vector<double> values(2 * 2 * 3, 0.0);
+            for (int y = 0; y < 8; ++y)
+                for (int x = 0; x < 8; ++x)
+                    for (int c = 0; c < 3; ++c) values[((y / 4) * 2 + x / 4) * 3 + c] += image(x, y)[c] / 16.0;
+            blocks.push_back(values);
+        }
+        Estimate result{std::vector<double>(12, 0.0), std::vector<double>(12, 0.0)};
+        for (int b = 0; b < 12; ++b) {
+            double sum = 0, squares = 0;
+            for (const auto& values : blocks) sum += values[b], squares += values[b] * values[b];
+            const double mean = sum / seeds;
+            const double variance = std::max(0.0, (squares - seeds * mean * mean) / (seeds - 1));
+            result.mean[b] = mean;
+            result.error[b] = std::sqrt(variance / seeds);
+        }
+        return result;
+    };
+    const Estimate reference = estimate({true, true, true, false, false});
+    for (const scene::RendererParams& params : all_params()) {
+        CAPTURE(describe(params));
+        const Estimate other = estimate(params);
+        for (int b = 0; b < 12; ++b) {
+            CAPTURE(b);
+            CAPTURE(reference.mean[b]);
+            CAPTURE(other.mean[b]);
+            CHECK(reference.mean[b] > 0.01);
+            const double noise = std::sqrt(reference.error[b] * reference.error[b] + other.error[b] * other.error[b]);
+            CHECK(std::abs(other.mean[b] - reference.mean[b]) <= 4.5 * noise + 1e-6);
+        }
+    }
+}
+
+TEST_CASE("PathTracer: the same seed gives the same image at 1 and 2 threads") {
+    TemporaryFolder folder;
+    scene::Scene world = prism::io::load_scene(folder.write("cornell.xml", cornell_xml));
+    world.cameras[0].num_samples = 16;
+    world.cameras[0].renderer = {true, true, true, true, true};
+    std::ostringstream log;
+    prism::RenderOptions one;
+    one.threads = 1;
+    one.backface_culling = prism::BackfaceCulling::none;
+    prism::RenderOptions two = one;
+    two.threads = 2;
+    const auto first = prism::render_scene(world, one, log);
+    const auto second = prism::render_scene(world, two, log);
+    REQUIRE(first.size() == 1);
+    bool identical = true;
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) identical &= first[0].image(x, y) == second[0].image(x, y);
+    CHECK(identical);
+    CHECK(log.str().find("path tracing") != std::string::npos);
+}
+
+TEST_CASE("dispatch: the path tracer only for scenes with a path-traced camera") {
+    using Whitted = prism::Config<float, prism::Bvh<prism::Watertight>, prism::AllLightSet, prism::all_features,
+                                  prism::Whitted>;
+    scene::Needs needs;
+    needs.lights = scene::bit(scene::LightKind::object);
+    CHECK(Whitted::covers(needs));
+    CHECK(PathConfig<float>::covers(needs));
+    needs.path_tracing = true;
+    CHECK_FALSE(Whitted::covers(needs));
+    CHECK(PathConfig<float>::covers(needs));
+    // The shipped list tries the ray tracers first: a scene without a path-traced camera never
+    // reaches the path tracer.
+    scene::Scene world = furnace();
+    std::ostringstream log;
+    prism::RenderOptions options;
+    options.max_samples = 1;
+    prism::render_scene(world, options, log);
+    CHECK(log.str().find("path tracing") == std::string::npos);
+}
