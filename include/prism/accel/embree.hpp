@@ -112,6 +112,7 @@ public:
     }
 
     SurfacePoint<Real> surface(const Ray<Real>& ray, const Hit<Real>& hit) const { return shapes_.surface(ray, hit); }
+    Vec3<Real> emitted(std::uint32_t object) const { return shapes_.emitted(object); }
     Vec3<Real> spawn_origin(const SurfacePoint<Real>& point, const Vec3<Real>& direction) const {
         return shapes_.spawn_origin(point, direction);
     }
