@@ -84,9 +84,9 @@ struct Times {
 // Renders a camera at a size; one per variant and scene, built (BVH included) before timing.
 using RenderFunction = std::function<prism::Image(const prism::scene::Camera&, int width, int height)>;
 
-template <class Real, class Intersector>
+template <class Real, class Intersector, class Acceleration = prism::Bvh<Intersector>>
 RenderFunction build_renderer(const prism::scene::Scene& scene, prism::RayOffset offset) {
-    using Config = prism::Config<Real, prism::Bvh<Intersector>, prism::Lights<prism::PointLight>>;
+    using Config = prism::Config<Real, Acceleration, prism::Lights<prism::PointLight>>;
     auto renderer = std::make_shared<const prism::Renderer<Config>>(scene, prism::RendererSettings{prism::BackfaceCulling::none, offset, 0});
     return [renderer](const prism::scene::Camera& camera, int width, int height) {
         return renderer->render(camera, width, height);
@@ -95,7 +95,7 @@ RenderFunction build_renderer(const prism::scene::Scene& scene, prism::RayOffset
 
 struct Variant {
     std::string name;    // legend and table
-    std::string marker;  // SVG marker shape: circle, square, diamond, triangle_up, triangle_down, cross
+    std::string marker;  // SVG marker shape: circle, square, diamond, triangle_up, triangle_down, plus, star, cross
     RenderFunction (*build)(const prism::scene::Scene&);
 };
 
@@ -111,6 +111,18 @@ const std::vector<Variant>& variants() {
          [](const prism::scene::Scene& s) { return build_renderer<float, prism::Watertight>(s, RayOffset::error_bound); }},
         {"DoubleRefine float, error bounds", "diamond",
          [](const prism::scene::Scene& s) { return build_renderer<float, prism::DoubleRefine>(s, RayOffset::error_bound); }},
+#ifdef PRISM_WITH_EMBREE
+        // Embree 3 traversing (accel/embree.hpp), prism's watertight float test on the triangle
+        // it finds: where Embree's float traversal stands beside prism's own.
+        {"Embree float, scene epsilon", "plus",
+         [](const prism::scene::Scene& s) {
+             return build_renderer<float, prism::Watertight, prism::Embree>(s, RayOffset::scene_epsilon);
+         }},
+        {"Embree float, error bounds", "star",
+         [](const prism::scene::Scene& s) {
+             return build_renderer<float, prism::Watertight, prism::Embree>(s, RayOffset::error_bound);
+         }},
+#endif
         {"Watertight double, scene epsilon", "square",
          [](const prism::scene::Scene& s) { return build_renderer<double, prism::Watertight>(s, RayOffset::scene_epsilon); }},
         {"Watertight double, error bounds (reference)", "circle",
@@ -363,6 +375,14 @@ std::string marker_svg(const std::string& shape, double x, double y, const std::
     } else if (shape == "triangle_down") {
         out << "<path d=\"M" << x << "," << y + r * 1.15 << " L" << x + r << "," << y - r * 0.75 << " L" << x - r << ","
             << y - r * 0.75 << " Z\" " << style << "/>";
+    } else if (shape == "plus") {
+        out << "<path d=\"M" << x - r << "," << y << " L" << x + r << "," << y << " M" << x << "," << y - r << " L" << x
+            << "," << y + r << "\" " << style << "/>";
+    } else if (shape == "star") {  // an asterisk: the plus and the cross over each other
+        out << "<path d=\"M" << x - r << "," << y << " L" << x + r << "," << y << " M" << x << "," << y - r << " L" << x
+            << "," << y + r << " M" << x - r * 0.7 << "," << y - r * 0.7 << " L" << x + r * 0.7 << "," << y + r * 0.7
+            << " M" << x - r * 0.7 << "," << y + r * 0.7 << " L" << x + r * 0.7 << "," << y - r * 0.7 << "\" " << style
+            << "/>";
     } else {  // cross
         out << "<path d=\"M" << x - r << "," << y - r << " L" << x + r << "," << y + r << " M" << x - r << "," << y + r
             << " L" << x + r << "," << y - r << "\" " << style << "/>";

@@ -7,6 +7,7 @@ find_dependency(pugixml CONFIG)
 find_dependency(nlohmann_json CONFIG)
 find_dependency(TBB CONFIG)
 find_dependency(tinyexr CONFIG)
+find_dependency(ZLIB)  # PNG writing (image/image_io.hpp); zlib1g-dev, which tinyexr needs too
 
 if(NOT TARGET prism::stb)
   find_path(PRISM_STB_INCLUDE_DIR stb_image.h PATH_SUFFIXES stb)

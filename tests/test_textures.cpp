@@ -451,6 +451,52 @@ TEST_CASE_TEMPLATE("SceneGeometry: textures live in a mesh's object space and in
     CHECK(on_sphere.texture_frame == Mat3<Real>(1));
 }
 
+TEST_CASE_TEMPLATE("Mesh bump: the tangent frame from a triangle's texture coordinates, against the displaced surface by hand",
+                   Real, float, double) {
+    // A triangle at z = 0 facing +z, twice as long in x as its (u, v) span: with (u, v) = (0, 0),
+    // (1, 0), (0, 1) at (0, 0, 0), (2, 0, 0), (0, 1, 0), dp/du = (2, 0, 0) and dp/dv = (0, 1, 0).
+    // An 8x8 height image h = 10 x + 3 y (file units), BumpFactor 0.1, bilinear: one texel's step
+    // changes h by 1 along u and 0.3 along v (the points below stay clear of the wrap). By hand, the displaced surface
+    // q = p + h n has q_u = (2, 0, 1) and q_v = (0, 1, 0.3), so n' = q_u x q_v = (-1, -0.6, 2).
+    scene::Scene world = scene_with_image_texture(grey_image(8, 8, [](int x, int y) { return 10 * x + 3 * y; }),
+                                                  scene::DecalMode::bump_normal);
+    world.textures[0].interpolation = scene::Interpolation::bilinear;
+    world.textures[0].bump_factor = 0.1;
+    world.materials.push_back(grey_material());
+    scene::Mesh triangle;
+    triangle.positions = {{0, 0, 0}, {2, 0, 0}, {0, 1, 0}};
+    triangle.uvs = {{0, 0}, {1, 0}, {0, 1}};
+    triangle.triangles = {{0, 1, 2}};
+    triangle.textures = {0};
+    world.meshes.push_back(triangle);
+    const auto bumped_normal_at = [&](const scene::Scene& scene, Vec3<Real> origin) {
+        const SceneGeometry<Real, Bvh<Watertight>, false> geometry(scene);
+        Ray<Real> ray{origin, Vec3<Real>(0, 0, -1), Real(0), infinity<Real>, Real(0)};
+        Hit<Real> hit;
+        REQUIRE(geometry.intersect(ray, hit));
+        SurfacePoint<Real> point = geometry.surface(ray, hit);
+        Material<Real> material(grey_material());
+        TextureSet<Real>(scene).apply(point, material);
+        return point.shading_normal;
+    };
+    // (u, v) = (0.375, 0.375) lies at (0.75, 0.375, 0).
+    check_vec(bumped_normal_at(world, {Real(0.75), Real(0.375), 1}), glm::normalize(Vec3<Real>(-1, Real(-0.6), 2)));
+
+    // u mirrored, as on the cube faces whose texture runs the other way: (u, v) = (1, 0), (0, 0),
+    // (1, 1), so dp/du = (-2, 0, 0) and heights rising with u rise towards -x. By hand q_u =
+    // (-2, 0, 1), q_v = (0, 1, 0.3), q_u x q_v = (-1, 0.6, -2), turned out of the surface:
+    // (1, -0.6, 2). (u, v) = (0.625, 0.375) lies at (0.75, 0.375, 0).
+    world.meshes[0].uvs = {{1, 0}, {0, 0}, {1, 1}};
+    check_vec(bumped_normal_at(world, {Real(0.75), Real(0.375), 1}), glm::normalize(Vec3<Real>(1, Real(-0.6), 2)));
+
+    // The same triangle turned a quarter about z by its transformation: the normal turns with it,
+    // (x, y) -> (-y, x), and the heights stay in object units.
+    world.meshes[0].uvs = {{0, 0}, {1, 0}, {0, 1}};
+    world.meshes[0].transform = glm::rotate(glm::dmat4(1.0), 1.5707963267948966, glm::dvec3(0, 0, 1));
+    check_vec(bumped_normal_at(world, {Real(-0.375), Real(0.75), 1}), glm::normalize(Vec3<Real>(Real(0.6), -1, 2)),
+              1e-4);
+}
+
 TEST_CASE_TEMPLATE("TextureSet: Perlin colours and bumps in the texture space", Real, float, double) {
     scene::Scene scene;
     scene::Texture texture;

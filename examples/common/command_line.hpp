@@ -56,6 +56,13 @@ public:
             if (mode == "error-bound") options.ray_offset = RayOffset::error_bound;
             else if (mode == "scene-epsilon") options.ray_offset = RayOffset::scene_epsilon;
             else usage_error("--ray-offset must be error-bound or scene-epsilon");
+        } else if (option == "--accelerator") {
+            const std::string_view accelerator = next_value();
+            if (accelerator == "prism") options.accelerator = AcceleratorChoice::prism;
+            else if (accelerator == "embree") options.accelerator = AcceleratorChoice::embree;
+            else usage_error("--accelerator must be prism or embree");
+            if (options.accelerator == AcceleratorChoice::embree && !embree_available)
+                usage_error("--accelerator embree: this prism was built without Embree 3 (libembree-dev)");
         } else if (option == "--cull-backfaces") {
             options.backface_culling = BackfaceCulling::all;
         } else if (option == "--no-cull-backfaces") {

@@ -51,6 +51,9 @@ options:
                        epsilon, unless it is below 64 ulps of the scene's largest coordinate
   --seed N             selects the pixels' random streams (default 0); any thread count gives
                        the same image for the same seed
+  --accelerator A      prism (its own BVH; the default) or embree: Embree 3 finds the hits,
+                       prism tests the triangle it finds and shades (float; only when built
+                       with libembree-dev)
   --untyped-mirrors M  a material with no type but a MirrorReflectance: ignore (Blinn-Phong only,
                        as the course's images of 2021-2025 scenes show; the default) or
                        reflect (a mirror, as 2017-2019 scene files, written before material
@@ -123,8 +126,8 @@ Arguments parse_arguments(int argc, char** argv) {
     return arguments;
 }
 
-// Ctrl-C: the first one asks the render to stop (checked after every tile) and restores the
-// default action, so that a second one ends the program at once.
+// Ctrl-C: the first one asks prism to stop (checked after loading and after every tile) and
+// restores the default action, so that a second one ends the program at once.
 std::atomic<bool> interrupted{false};
 
 extern "C" void on_interrupt(int) {
@@ -140,8 +143,10 @@ int main(int argc, char** argv) {
     const Arguments arguments = parse_arguments(argc, argv);
     std::ostringstream silent;
     std::ostream& log = arguments.quiet ? static_cast<std::ostream&>(silent) : std::cout;
+    std::signal(SIGINT, on_interrupt);
     try {
         const prism::scene::Scene scene = prism::io::load_scene(arguments.scene, arguments.load);
+        if (interrupted.load()) throw Interrupted{};
         if (scene.cameras.empty()) throw prism::io::LoadError(arguments.scene, "<Cameras>", "the scene has no camera");
 
         // Every output's place is checked before the render, so a refused name costs no render time.
@@ -156,7 +161,6 @@ int main(int argc, char** argv) {
 
         const std::size_t total_pixels = prism::total_pixels(scene, arguments.options);
         prism::ProgressBar progress(total_pixels, !arguments.quiet);
-        std::signal(SIGINT, on_interrupt);
         // An exception thrown from a tile cancels the parallel render and reaches this thread.
         const auto images = prism::render_scene(scene, arguments.options, log, [&](std::size_t, int pixels) {
             if (interrupted.load()) throw Interrupted{};

@@ -73,6 +73,8 @@ options:
   --cull-backfaces     camera rays ignore every triangle and plane facing away from them
   --no-cull-backfaces  camera rays see every surface from both sides (default: the course's
                        rule, back-facing triangles of flat-shaded meshes only)
+  --accelerator A      prism (the default) or embree (Embree 3 finds the hits; only when built
+                       with libembree-dev)
   --verbose            print the renderer's log (configuration, build times) on stderr
   --help               this text
 

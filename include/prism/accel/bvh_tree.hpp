@@ -67,6 +67,9 @@ public:
     const std::vector<std::uint32_t>& primitive_indices() const { return primitive_indices_; }
     Aabb<Real> bounds() const { return nodes_.empty() ? Aabb<Real>{} : nodes_[0].bounds; }
     int depth() const { return nodes_.empty() ? 0 : depth_of(0); }
+    std::size_t memory_bytes() const {
+        return nodes_.capacity() * sizeof(BvhNode<Real>) + primitive_indices_.capacity() * sizeof(std::uint32_t);
+    }
 
     // Closest hit: `leaf(first, count, t_max)` tests primitive_indices[first, first + count),
     // lowering t_max on hits. Children are visited nearest first so t_max prunes early.

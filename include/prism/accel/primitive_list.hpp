@@ -24,6 +24,7 @@ public:
 
     const std::vector<std::uint32_t>& primitive_indices() const { return primitive_indices_; }
     Aabb<Real> bounds() const { return bounds_; }
+    std::size_t memory_bytes() const { return primitive_indices_.capacity() * sizeof(std::uint32_t); }
 
     template <class Leaf>
     void traverse_closest(const Ray<Real>&, Real& t_max, Leaf&& leaf) const {

@@ -94,6 +94,12 @@ public:
         return total;
     }
     Aabb<Real> bounds() const { return top_.bounds(); }
+    // The indices of both levels and the triangles their leaves test (bench/scaling_bench.cpp).
+    std::size_t accelerator_bytes() const {
+        std::size_t total = top_.memory_bytes();
+        for (const auto& mesh : meshes_) total += mesh.accelerator_bytes();
+        return total;
+    }
 
     // Closest hit in (ray.t_min, ray.t_max]; on a hit, ray.t_max becomes the hit distance.
     // `Culling` names the surfaces skipped when the ray meets them from behind
@@ -114,6 +120,14 @@ public:
             found |= leaf_hit;
             return leaf_hit;
         });
+        return intersect_planes<Culling>(ray, hit) || found;
+    }
+
+    // Planes are unbounded, so no index holds them: every ray tests each one (closest hit, as
+    // intersect above).
+    template <BackfaceCulling Culling = BackfaceCulling::none>
+    bool intersect_planes(Ray<Real>& ray, Hit<Real>& hit) const {
+        bool found = false;
         for (std::size_t p = 0; p < planes_.size(); ++p) {
             Real t;
             if (planes_[p].intersect(ray, ray.t_min, ray.t_max, t)) {
@@ -137,13 +151,50 @@ public:
                     if (occludes(instances_[order[i]], ray, t_max)) return true;
                 return false;
             });
-        if (blocked) return true;
+        return blocked || occluded_by_planes(ray);
+    }
+
+    bool occluded_by_planes(const Ray<Real>& ray) const {
         for (const auto& plane : planes_) {
             Real t;
             if (plane.intersect(ray, ray.t_min, ray.t_max, t) && t < ray.t_max) return true;
         }
         return false;
     }
+
+    // One primitive of one object, tested as intersect tests it (world-space ray, the
+    // policy's triangle test, the sphere test): for an index other than the policy's own (an
+    // Embree scene, accel/embree.hpp) that finds the primitive but leaves prism to compute the
+    // hit. `primitive` is a triangle's position in its mesh (identity order under BruteForce);
+    // spheres ignore it. On a hit in (t_min, t_max] it lowers ray.t_max and fills hit.
+    bool intersect_primitive(std::uint32_t object, std::uint32_t primitive, Ray<Real>& ray, Hit<Real>& hit) const {
+        const Instance& instance = instances_[object];
+        const Ray<Real> local = to_object(instance, ray);
+        bool found;
+        if (instance.kind == Kind::mesh) {
+            found = meshes_[instance.shape].intersect_triangle(primitive, local, ray.t_max, hit);
+        } else {
+            Real t;
+            found = spheres_[instance.shape].intersect(local, ray.t_min, ray.t_max, t);
+            if (found) {
+                ray.t_max = t;
+                hit = Hit<Real>{t, object, 0, 0, 0};
+            }
+        }
+        if (found) hit.object = object;
+        return found;
+    }
+
+    // What an outside index needs to mirror the objects: whether object i is a sphere, and the
+    // world box intersect's own index holds for it (covering a moving object's sweep).
+    bool is_sphere(std::uint32_t object) const { return instances_[object].kind == Kind::sphere; }
+    // Whether camera rays skip object's back-facing triangles under `culling`, as intersect does.
+    bool culls(std::uint32_t object, BackfaceCulling culling) const {
+        const Instance& instance = instances_[object];
+        return instance.kind == Kind::mesh && (culling == BackfaceCulling::all ||
+                                               (culling == BackfaceCulling::flat_triangles && !meshes_[instance.shape].smooth()));
+    }
+    Aabb<Real> world_bounds(std::uint32_t object) const { return instances_[object].world_bounds; }
 
     SurfacePoint<Real> surface(const Ray<Real>& ray, const Hit<Real>& hit) const {
         SurfacePoint<Real> point;
@@ -347,6 +398,18 @@ private:
     std::vector<Instance> instances_;
     std::vector<InstanceTransforms<Real>> transforms_;
     Index top_;
+};
+
+// The geometry a renderer builds for an acceleration policy: a SceneGeometry traversed by the
+// policy's own indices, unless the policy brings its own Geometry (Embree, accel/embree.hpp).
+template <class Policy, Scalar Real, bool MotionBlur>
+struct GeometryOf {
+    using type = SceneGeometry<Real, Policy, MotionBlur>;
+};
+template <class Policy, Scalar Real, bool MotionBlur>
+    requires requires { typename Policy::template Geometry<Real, MotionBlur>; }
+struct GeometryOf<Policy, Real, MotionBlur> {
+    using type = typename Policy::template Geometry<Real, MotionBlur>;
 };
 
 }  // namespace prism

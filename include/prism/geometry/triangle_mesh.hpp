@@ -59,6 +59,8 @@ public:
     Aabb<Real> bounds() const { return bounds_; }
     std::size_t triangle_count() const { return triangles_.size(); }
     bool smooth() const { return smooth_; }  // shadingMode="smooth": normals interpolated from the vertices
+    // What traversal reads: the index and the triangles its leaves test (not the shading data).
+    std::size_t accelerator_bytes() const { return index_.memory_bytes() + triangles_.capacity() * sizeof(triangles_[0]); }
 
     // Closest hit along `ray` (object space) below t_max; lowers t_max and fills t, primitive,
     // barycentrics. Culling skips triangles whose winding faces away from the ray.
@@ -87,6 +89,19 @@ public:
             return leaf_hit;
         });
         return found;
+    }
+
+    // The triangle in `slot` alone, with the same test and the same hit record as intersect.
+    bool intersect_triangle(std::uint32_t slot, const Ray<Real>& ray, Real& t_max, Hit<Real>& hit) const {
+        const auto& p = triangles_[slot];
+        TriangleHit<Real> triangle_hit;
+        if (!Intersector::intersect(Prepared(ray), p[0], p[1], p[2], ray.t_min, t_max, triangle_hit)) return false;
+        t_max = triangle_hit.t;
+        hit.t = triangle_hit.t;
+        hit.primitive = slot;
+        hit.b1 = triangle_hit.b1;
+        hit.b2 = triangle_hit.b2;
+        return true;
     }
 
     bool occluded(const Ray<Real>& ray, Real t_max) const {

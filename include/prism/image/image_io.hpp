@@ -3,6 +3,7 @@
 // in their system libraries (libstb, libtinyexr), so no *_IMPLEMENTATION macro is defined here.
 #pragma once
 
+#include <prism/image/decoder_guard.hpp>
 #include <prism/image/image.hpp>
 #include <prism/io/limits.hpp>
 #include <prism/io/load_error.hpp>
@@ -10,8 +11,10 @@
 #include <stb_image.h>
 #include <stb_image_write.h>
 #include <tinyexr.h>
+#include <zlib.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cctype>
 #include <cmath>
@@ -127,6 +130,51 @@ inline void write_ppm(const std::filesystem::path& path, const Image& image, con
     if (!out) throw io::LoadError(shown, "ImageName", "cannot write the PPM file");
 }
 
+// An 8-bit RGB PNG (PNG specification, ISO/IEC 15948): every row with the Sub filter, one
+// zlib stream at zlib's default level. stb's writer tries five filters per row and compresses
+// with its own deflate: 214 ms for an 800 x 800 course image here, against 54 ms for this (and
+// 29 kB instead of 38 kB); on the small hw1 scenes that was a fifth of the whole process.
+inline bool write_png(const std::filesystem::path& path, const std::vector<std::uint8_t>& rgb, int width,
+                      int height) {
+    const std::size_t row = std::size_t(width) * 3;
+    std::vector<std::uint8_t> filtered;
+    filtered.reserve((row + 1) * std::size_t(height));
+    for (int y = 0; y < height; ++y) {
+        const std::uint8_t* line = rgb.data() + std::size_t(y) * row;
+        filtered.push_back(1);  // Sub: each byte minus the byte one pixel to its left
+        for (std::size_t i = 0; i < row; ++i) filtered.push_back(std::uint8_t(line[i] - (i >= 3 ? line[i - 3] : 0)));
+    }
+    uLongf compressed_size = compressBound(uLong(filtered.size()));
+    std::vector<std::uint8_t> compressed(compressed_size);
+    if (compress2(compressed.data(), &compressed_size, filtered.data(), uLong(filtered.size()), Z_DEFAULT_COMPRESSION) !=
+        Z_OK)
+        return false;
+    compressed.resize(compressed_size);
+
+    std::ofstream out(path, std::ios::binary);
+    const auto put32 = [&](std::uint32_t value) {
+        const std::array<char, 4> bytes{char(value >> 24), char(value >> 16), char(value >> 8), char(value)};
+        out.write(bytes.data(), 4);
+    };
+    const auto chunk = [&](const char* type, const std::uint8_t* data, std::size_t size) {
+        put32(std::uint32_t(size));
+        out.write(type, 4);
+        out.write(reinterpret_cast<const char*>(data), std::streamsize(size));
+        uLong crc = crc32(0L, reinterpret_cast<const Bytef*>(type), 4);
+        if (size > 0) crc = crc32(crc, data, uInt(size));  // (a null buffer would restart the crc)
+        put32(std::uint32_t(crc));
+    };
+    out.write("\x89PNG\r\n\x1a\n", 8);
+    const std::array<std::uint8_t, 13> header{
+        std::uint8_t(width >> 24), std::uint8_t(width >> 16), std::uint8_t(width >> 8), std::uint8_t(width),
+        std::uint8_t(height >> 24), std::uint8_t(height >> 16), std::uint8_t(height >> 8), std::uint8_t(height),
+        8, 2, 0, 0, 0};  // 8 bits, RGB, deflate, adaptive filtering, no interlace
+    chunk("IHDR", header.data(), header.size());
+    chunk("IDAT", compressed.data(), compressed.size());
+    chunk("IEND", nullptr, 0);
+    return bool(out);
+}
+
 }  // namespace detail
 
 // Writes `.png` or `.ppm` (8-bit, to_8bit) or `.exr` (linear float RGB). Missing parent folders are
@@ -150,7 +198,7 @@ inline void write_image(const std::filesystem::path& path, const Image& image) {
     try {
         if (extension == ".png") {
             const std::vector<std::uint8_t> bytes = to_8bit(image);
-            if (!stbi_write_png(temporary.c_str(), image.width, image.height, 3, bytes.data(), image.width * 3))
+            if (!detail::write_png(temporary, bytes, image.width, image.height))
                 throw io::LoadError(path, "ImageName", "cannot write the PNG file");
         } else if (extension == ".ppm") {
             detail::write_ppm(temporary, image, path);
@@ -275,6 +323,12 @@ inline Image decode_image(std::string_view bytes, const std::filesystem::path& p
     const bool is_ldr = extension == ".png" || extension == ".jpg" || extension == ".jpeg" || extension == ".bmp" ||
                         extension == ".tga" || extension == ".ppm" || extension == ".pgm";
     if (!is_hdr && !is_ldr) throw io::LoadError(path, "", "unsupported image format '" + extension + "'");
+    if (!detail::has_signature_of(bytes, extension))
+        throw io::LoadError(path, "", "the file's content is not the " + extension.substr(1) + " image its name says");
+    if ((extension == ".jpg" || extension == ".jpeg") && !detail::jpeg_huffman_tables_fit(bytes))
+        throw io::LoadError(path, "", "corrupt JPEG: a Huffman table of more than 256 codes");
+    if ((extension == ".ppm" || extension == ".pgm") && !detail::pnm_header_fits(bytes))
+        throw io::LoadError(path, "", "unsupported PNM header: a number past 2147483647 or 16-bit samples");
     // stb takes an int length.
     if (bytes.size() > std::size_t(std::numeric_limits<int>::max()))
         throw io::LoadError(path, "", "the file is larger than 2 GiB");

@@ -15,6 +15,10 @@
 #include <prism/scene/needs.hpp>
 #include <prism/scene/scene.hpp>
 
+#ifdef PRISM_WITH_EMBREE
+#include <prism/accel/embree.hpp>
+#endif
+
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
@@ -43,6 +47,17 @@ inline const char* describe(Precision precision) {
     return "?";
 }
 
+// Which index finds the hits: prism's own, or Embree 3's (accel/embree.hpp; only in programs
+// built with it, PRISM_WITH_EMBREE).
+enum class AcceleratorChoice { prism, embree };
+
+inline constexpr bool embree_available =
+#ifdef PRISM_WITH_EMBREE
+    true;
+#else
+    false;
+#endif
+
 struct RenderOptions {
     int threads = 0;                      // 0: all hardware threads
     std::optional<Precision> precision;   // empty: chosen from the scene
@@ -51,6 +66,7 @@ struct RenderOptions {
     BackfaceCulling backface_culling = BackfaceCulling::flat_triangles;  // what camera rays skip from behind
     std::optional<RayOffset> ray_offset;  // empty: chosen from the scene (choose_ray_offset)
     std::uint64_t seed = 0;               // the pixels' random streams (multisampling, lights)
+    AcceleratorChoice accelerator = AcceleratorChoice::prism;
 };
 
 struct CameraImage {
@@ -220,18 +236,35 @@ inline std::vector<CameraImage> render_scene(
     const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
     tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
     const scene::PrecisionFeatures measured = scene::measure_precision(scene);
-    const Choice choice = choose_precision(measured, options);
+    Choice choice = choose_precision(measured, options);
+    const bool embree = options.accelerator == AcceleratorChoice::embree;
+    if (embree) {
+        if constexpr (!embree_available)
+            throw std::invalid_argument("--accelerator embree: this prism was built without Embree 3 (libembree-dev)");
+        if (choice.precision != Precision::single)
+            log << "note: Embree traverses in float; prism's own accelerator would take "
+                << describe(choice.precision) << " (" << choice.reason << ")\n";
+        choice = {Precision::single, "Embree traverses in float"};
+    }
     std::string offset_reason;
     RenderOptions chosen = options;
     chosen.ray_offset = choose_ray_offset(scene, measured, choice.precision, options, offset_reason);
     const scene::Needs needs = scene::measure_needs(scene);
     const std::string beyond = needs.beyond(Config<float, Bvh<Watertight>, PointLightSet, no_features>::meets);
-    log << "configuration: " << describe(choice.precision) << " (" << choice.reason << "); "
+    log << "configuration: "
+        << (embree ? "Embree 3 BVH, prism's watertight triangle test on the triangle Embree finds"
+                   : describe(choice.precision))
+        << " (" << choice.reason << "); "
         << (beyond.empty() ? "point lights only, no textures or motion blur"
                            : "all light types, textures and motion blur (the scene has " + beyond + ")")
         << "; rays leave surfaces by "
         << (*chosen.ray_offset == RayOffset::error_bound ? "their error bounds" : "the ShadowRayEpsilon") << " ("
         << offset_reason << ")\n";
+#ifdef PRISM_WITH_EMBREE
+    if (embree)
+        return detail::render_first_covering(ShippedConfigs<Precision::single, float, Embree>{}, needs, scene, chosen,
+                                             log, on_tile);
+#endif
     switch (choice.precision) {
         case Precision::single:
             return detail::render_first_covering(ShippedConfigs<Precision::single>{}, needs, scene, chosen, log, on_tile);

@@ -35,7 +35,7 @@ class Renderer {
 public:
     using Real = typename C::Real;
     static constexpr Features features = C::features;
-    using Geometry = SceneGeometry<Real, typename C::Acceleration, features.motion_blur>;
+    using Geometry = typename GeometryOf<typename C::Acceleration, Real, features.motion_blur>::type;
     using LightSetT = typename C::LightTypes::template Set<Real>;
     using TexturesT = std::conditional_t<features.textures, TextureSet<Real>, NoTextures<Real>>;
     static constexpr bool environment_lights = C::LightTypes::template contains<EnvironmentLight>;

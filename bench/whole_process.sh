@@ -1,0 +1,116 @@
+#!/usr/bin/env bash
+# Whole-process wall time of two `prism` binaries on the course scenes, paired: every round runs
+# each scene with both binaries back to back, in alternating order, so the load of a shared
+# machine falls on both alike. Prints one line per scene: the median of each binary's times, the
+# median of the per-round ratios new/old, and whether the two binaries wrote the same images
+# (cmp, byte for byte). Used for bench/RESULTS.md ("Whole renders").
+#
+#   bash bench/whole_process.sh OLD_PRISM NEW_PRISM [--rounds N] [--threads T] [--shared DIR]
+#                               [--topics hw1,hw2] [--extra PATH]... [-- NEW_PRISM_OPTIONS...]
+#
+# Scenes: every distinct hw1/hw2 path of MANIFEST.tsv (default) and each --extra path (relative
+# to the course folder). Scenes either binary refuses are listed as such and skipped.
+set -euo pipefail
+
+old=$1 new=$2
+shift 2
+rounds=3 threads=2 shared=../shared topics=hw1,hw2
+extras=()
+new_options=()
+while [[ $# -gt 0 ]]; do
+  case $1 in
+    --rounds) rounds=$2; shift 2 ;;
+    --threads) threads=$2; shift 2 ;;
+    --shared) shared=$2; shift 2 ;;
+    --topics) topics=$2; shift 2 ;;
+    --extra) extras+=("$2"); shift 2 ;;
+    --) shift; new_options=("$@"); break ;;
+    *) echo "unknown option $1" >&2; exit 2 ;;
+  esac
+done
+course=$shared/ceng795
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+mapfile -t scenes < <(awk -F'\t' -v topics=",$topics," 'NR > 1 && index(topics, "," $1 ",") { print $4 }' \
+                        "$course/MANIFEST.tsv" | sort -u)
+scenes+=("${extras[@]}")
+
+now() { date +%s.%N; }
+run() {  # binary, output folder, scene, options...: prints seconds, or "refused"
+  local binary=$1 out=$2 scene=$3
+  shift 3
+  rm -rf "$out" && mkdir -p "$out"
+  local start end
+  start=$(now)
+  if "$binary" "$course/$scene" --output-dir "$out" --threads "$threads" --quiet "$@" >/dev/null 2>&1; then
+    end=$(now)
+    echo "$end - $start" | bc -l
+  else
+    echo refused
+  fi
+}
+# Whether two image files hold the same pixels: PNGs are decoded (8-bit, non-interlaced; the
+# two binaries may compress differently), other files compared byte for byte.
+same_pixels() {
+  [[ -f $2 ]] || return 1
+  [[ $1 == *.png ]] || { cmp -s "$1" "$2"; return; }
+  python3 - "$1" "$2" <<'EOF'
+import struct, sys, zlib
+def pixels(path):
+    data = open(path, 'rb').read()
+    at, idat = 8, b''
+    while at < len(data):
+        size, kind = struct.unpack('>I4s', data[at:at + 8])
+        body = data[at + 8:at + 8 + size]
+        if kind == b'IHDR':
+            width, height, depth, colour = struct.unpack('>IIBB', body[:10])
+            channels = {0: 1, 2: 3, 4: 2, 6: 4}[colour]
+        elif kind == b'IDAT':
+            idat += body
+        at += 12 + size
+    raw, stride, rows, previous = zlib.decompress(idat), width * channels, [], bytearray(width * channels)
+    for y in range(height):
+        kind, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = line[i - channels] if i >= channels else 0
+            b, c = previous[i], previous[i - channels] if i >= channels else 0
+            if kind == 1: line[i] = (line[i] + a) & 255
+            elif kind == 2: line[i] = (line[i] + b) & 255
+            elif kind == 3: line[i] = (line[i] + (a + b) // 2) & 255
+            elif kind == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        rows.append(bytes(line))
+        previous = line
+    return depth, channels, rows
+sys.exit(0 if pixels(sys.argv[1]) == pixels(sys.argv[2]) else 1)
+EOF
+}
+median() { sort -g | awk '{ a[NR] = $1 } END { print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2 }'; }
+
+printf '%s\t%s\t%s\t%s\t%s\n' scene old_s new_s new/old same_images
+for scene in "${scenes[@]}"; do
+  old_times=() new_times=() ratios=() refused=
+  for ((round = 0; round < rounds; ++round)); do
+    if ((round % 2 == 0)); then
+      t_old=$(run "$old" "$work/old" "$scene"); t_new=$(run "$new" "$work/new" "$scene" "${new_options[@]}")
+    else
+      t_new=$(run "$new" "$work/new" "$scene" "${new_options[@]}"); t_old=$(run "$old" "$work/old" "$scene")
+    fi
+    if [[ $t_old == refused || $t_new == refused ]]; then refused=yes; break; fi
+    old_times+=("$t_old") new_times+=("$t_new") ratios+=("$(echo "$t_new / $t_old" | bc -l)")
+  done
+  if [[ -n $refused ]]; then
+    printf '%s\trefused\n' "$scene"
+    continue
+  fi
+  same=yes
+  for image in "$work"/old/*; do
+    same_pixels "$image" "$work/new/$(basename "$image")" || same=no
+  done
+  printf '%s\t%.3f\t%.3f\t%.3f\t%s\n' "$scene" \
+    "$(printf '%s\n' "${old_times[@]}" | median)" "$(printf '%s\n' "${new_times[@]}" | median)" \
+    "$(printf '%s\n' "${ratios[@]}" | median)" "$same"
+done

@@ -1,0 +1,362 @@
+// Embree 3 as an acceleration policy: `Config<float, Embree, ...>` renders any scene with Embree
+// finding the hits and prism doing everything else. Embree replaces the traversal, not the
+// shading: the scene's shapes, transforms, textures and surface() stay in a SceneGeometry
+// (under BruteForce, whose index is only the identity order and is never traversed), and
+// Embree's scene mirrors its objects, with Embree's geometry IDs equal to prism's object
+// indices. Embree only traverses: every triangle its own test accepts is tested again by
+// prism's watertight test in a filter callback, and only prism's yes counts; prism's test on
+// the closest one then computes t and the barycentrics, so a hit is shaded from exactly the
+// numbers prism's own accelerator would give for it. (With Embree's answer taken as it was,
+// 13 of the 57 hw1/hw2 course images lost 0.01 to 1 dB: edges Embree's float test hits and the
+// watertight test gives to the neighbour.) The images then differ only where two triangles
+// tie at a shared edge and the two traversals pick different ones.
+// Needs libembree-dev; the CMake build defines PRISM_WITH_EMBREE when it finds it.
+#pragma once
+
+#include <prism/accel/accelerator.hpp>
+#include <prism/geometry/scene_geometry.hpp>
+
+#include <embree3/rtcore.h>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace prism {
+
+template <Scalar Real, bool MotionBlur> class EmbreeGeometry;
+
+// The policy. Intersector and Index name how the shapes are stored for prism's own per-primitive
+// test (AccelerationPolicy); Geometry is what the renderer builds instead of SceneGeometry.
+struct Embree {
+    using Intersector = Watertight;
+    template <Scalar Real> using Index = PrimitiveList<Real>;
+    template <Scalar Real, bool MotionBlur> using Geometry = EmbreeGeometry<Real, MotionBlur>;
+};
+
+// Embree's traversal and triangle test are in float. In a double renderer the filter's test is
+// prism's double test: rays leave surfaces by double-precision error bounds, far below a float
+// ulp, and Embree's float test alone finds the surface a ray just left (4% of the shadow rays
+// of hw2 horse_instanced came back occluded).
+template <Scalar Real, bool MotionBlur = false>
+class EmbreeGeometry {
+public:
+    using Shapes = SceneGeometry<Real, BruteForce<Watertight>, MotionBlur>;
+
+    explicit EmbreeGeometry(const scene::Scene& scene, unsigned threads = 0)
+        : shapes_(scene), device_(make_device(threads)), scene_(rtcNewScene(device_.get())) {
+        std::vector<std::uint32_t> object_of_mesh(scene.meshes.size());
+        std::uint32_t object = 0;
+        for (std::size_t m = 0; m < scene.meshes.size(); ++m)
+            add_mesh_object(scene, m, scene.meshes[m].transform, scene.meshes[m].motion, object++);
+        for (const auto& instance : scene.mesh_instances)
+            add_mesh_object(scene, instance.base_mesh, instance.transform, instance.motion, object++);
+        user_data_.reserve(scene.spheres.size());
+        for (std::size_t s = 0; s < scene.spheres.size(); ++s) add_sphere_object(object++);
+        if (object != shapes_.instance_count())
+            throw std::logic_error("EmbreeGeometry: objects out of step with SceneGeometry");
+        rtcSetSceneFlags(scene_.get(), RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+        rtcCommitScene(scene_.get());
+        check("committing the scene");
+    }
+
+    std::size_t instance_count() const { return shapes_.instance_count(); }
+    std::size_t triangle_count() const { return shapes_.triangle_count(); }
+    Aabb<Real> bounds() const { return shapes_.bounds(); }
+
+    // Closest hit in (ray.t_min, ray.t_max]; on a hit, ray.t_max becomes the hit distance.
+    template <BackfaceCulling Culling = BackfaceCulling::none>
+    bool intersect(Ray<Real>& ray, Hit<Real>& hit) const {
+        RTCRayHit ray_hit;
+        ray_hit.ray = embree_ray(ray, ray.t_max);
+        ray_hit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        ray_hit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        Context context(this, ray);
+        context.base.filter = filter_for<Culling, false>();
+        rtcIntersect1(scene_.get(), &context.base, &ray_hit);
+        bool found = false;
+        if (ray_hit.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
+            const std::uint32_t object =
+                ray_hit.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? ray_hit.hit.instID[0] : ray_hit.hit.geomID;
+            // prism's test on Embree's primitive, which the filter accepted with the same ray:
+            // the fallback to Embree's numbers is for safety only.
+            Ray<Real> probe = ray;
+            if (!shapes_.intersect_primitive(object, ray_hit.hit.primID, probe, hit))
+                hit = Hit<Real>{Real(ray_hit.ray.tfar), object, ray_hit.hit.primID, Real(ray_hit.hit.u),
+                                Real(ray_hit.hit.v)};
+            ray.t_max = hit.t;
+            found = true;
+        }
+        return shapes_.template intersect_planes<Culling>(ray, hit) || found;
+    }
+
+    // Whether anything lies in (ray.t_min, ray.t_max): open at t_max, like prism's own.
+    bool occluded(const Ray<Real>& ray) const {
+        RTCRay embree = embree_ray(ray, ray.t_max);
+        // Open at t_max: prism's test in the filter decides, so Embree's closed interval must
+        // not end early (a double t_max rounded down to float would).
+        if (embree.tfar < std::numeric_limits<float>::infinity())
+            embree.tfar = std::nextafter(embree.tfar, std::numeric_limits<float>::infinity());
+        Context context(this, ray);
+        context.base.filter = filter_for<BackfaceCulling::none, true>();
+        rtcOccluded1(scene_.get(), &context.base, &embree);
+        return embree.tfar == -std::numeric_limits<float>::infinity() || shapes_.occluded_by_planes(ray);
+    }
+
+    SurfacePoint<Real> surface(const Ray<Real>& ray, const Hit<Real>& hit) const { return shapes_.surface(ray, hit); }
+    Vec3<Real> spawn_origin(const SurfacePoint<Real>& point, const Vec3<Real>& direction) const {
+        return shapes_.spawn_origin(point, direction);
+    }
+
+    // Bytes Embree holds for this scene (its BVHs and copies of the triangles), as its memory
+    // monitor counted them during the build.
+    std::int64_t embree_bytes() const { return device_.bytes(); }
+
+private:
+    // Embree's handles, released in order (scene before device).
+    struct DeviceHandle {
+        RTCDevice device = nullptr;
+        std::unique_ptr<std::int64_t> bytes_in_use = std::make_unique<std::int64_t>(0);
+        RTCDevice get() const { return device; }
+        std::int64_t bytes() const { return *bytes_in_use; }
+        DeviceHandle(RTCDevice d) : device(d) {}
+        DeviceHandle(DeviceHandle&& other) noexcept
+            : device(std::exchange(other.device, nullptr)), bytes_in_use(std::move(other.bytes_in_use)) {}
+        ~DeviceHandle() {
+            if (device) rtcReleaseDevice(device);
+        }
+    };
+    struct SceneHandle {
+        RTCScene scene = nullptr;
+        RTCScene get() const { return scene; }
+        explicit SceneHandle(RTCScene s) : scene(s) {}
+        SceneHandle(SceneHandle&& other) noexcept : scene(std::exchange(other.scene, nullptr)) {}
+        ~SceneHandle() {
+            if (scene) rtcReleaseScene(scene);
+        }
+    };
+
+    // The intersect context carries the geometry to the callbacks (Embree's documented way of
+    // passing per-query data: a struct that starts with RTCIntersectContext).
+    struct Context {
+        RTCIntersectContext base;
+        const EmbreeGeometry* self;
+        const Ray<Real>* world_ray;  // the query's ray, in Real, for prism's test in the filter
+        Context(const EmbreeGeometry* geometry, const Ray<Real>& ray) : self(geometry), world_ray(&ray) {
+            rtcInitIntersectContext(&base);
+        }
+    };
+
+    struct SphereUserData {
+        const EmbreeGeometry* self;
+        std::uint32_t object;
+    };
+
+    DeviceHandle make_device(unsigned threads) {
+        const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : std::string();
+        RTCDevice device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
+        if (device == nullptr) throw std::runtime_error("Embree: rtcNewDevice failed");
+        DeviceHandle handle(device);
+        rtcSetDeviceMemoryMonitorFunction(
+            device,
+            [](void* user, ssize_t bytes, bool) {
+                *static_cast<std::int64_t*>(user) += bytes;
+                return true;
+            },
+            handle.bytes_in_use.get());
+        return handle;
+    }
+
+    void check(const char* what) const {
+        const RTCError error = rtcGetDeviceError(device_.get());
+        if (error != RTC_ERROR_NONE)
+            throw std::runtime_error(std::string("Embree: error ") + std::to_string(int(error)) + " " + what);
+    }
+
+    static RTCRay embree_ray(const Ray<Real>& ray, Real t_max) {
+        RTCRay result;
+        result.org_x = float(ray.origin.x);
+        result.org_y = float(ray.origin.y);
+        result.org_z = float(ray.origin.z);
+        result.tnear = float(ray.t_min);
+        result.dir_x = float(ray.direction.x);
+        result.dir_y = float(ray.direction.y);
+        result.dir_z = float(ray.direction.z);
+        result.time = float(ray.time);
+        result.tfar = float(t_max);
+        result.mask = ~0u;
+        result.id = 0;
+        result.flags = 0;
+        return result;
+    }
+
+    // The mesh's triangles in its object space, as a float triangle geometry; one Embree scene
+    // per mesh, made once and shared by every object that places it.
+    RTCScene mesh_scene(const scene::Scene& scene, std::size_t mesh_index) {
+        if (mesh_scenes_.size() < scene.meshes.size()) mesh_scenes_.resize(scene.meshes.size());
+        std::unique_ptr<SceneHandle>& cached = mesh_scenes_[mesh_index];
+        if (cached) return cached->get();
+        cached = std::make_unique<SceneHandle>(rtcNewScene(device_.get()));
+        RTCGeometry geometry = triangle_geometry(scene.meshes[mesh_index]);
+        rtcAttachGeometryByID(cached->get(), geometry, 0);
+        rtcReleaseGeometry(geometry);
+        rtcSetSceneFlags(cached->get(), RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+        rtcCommitScene(cached->get());
+        check("building a mesh");
+        return cached->get();
+    }
+
+    RTCGeometry triangle_geometry(const scene::Mesh& mesh) {
+        RTCGeometry geometry = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
+        auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+            geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.positions.size()));
+        for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+            const glm::vec3 p(mesh.positions[v]);  // rounded once, as prism's float meshes are
+            vertices[3 * v + 0] = p.x;
+            vertices[3 * v + 1] = p.y;
+            vertices[3 * v + 2] = p.z;
+        }
+        auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+            geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), mesh.triangles.size()));
+        for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+            for (int k = 0; k < 3; ++k) indices[3 * t + k] = mesh.triangles[t][k];
+        rtcCommitGeometry(geometry);
+        return geometry;
+    }
+
+    // A mesh placed by `transform` (and moving by `motion` over the shutter): its triangles go
+    // straight into the top scene when it is not moved at all, else an instance of its scene.
+    void add_mesh_object(const scene::Scene& scene, std::size_t mesh_index, const glm::dmat4& transform,
+                         const glm::dvec3& motion, std::uint32_t object) {
+        const bool moving = MotionBlur && motion != glm::dvec3(0.0);
+        RTCGeometry geometry;
+        if (transform == glm::dmat4(1.0) && !moving) {
+            geometry = triangle_geometry(scene.meshes[mesh_index]);
+        } else {
+            geometry = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_INSTANCE);
+            rtcSetGeometryInstancedScene(geometry, mesh_scene(scene, mesh_index));
+            rtcSetGeometryTimeStepCount(geometry, moving ? 2 : 1);
+            const glm::mat4 at_start(transform);
+            rtcSetGeometryTransform(geometry, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &at_start[0][0]);
+            if (moving) {
+                // A translation is linear in time, so Embree's interpolation of the two ends is
+                // the motion itself.
+                const glm::mat4 at_end(glm::translate(glm::dmat4(1.0), motion) * transform);
+                rtcSetGeometryTransform(geometry, 1, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &at_end[0][0]);
+            }
+            rtcCommitGeometry(geometry);
+        }
+        rtcAttachGeometryByID(scene_.get(), geometry, object);
+        rtcReleaseGeometry(geometry);
+        check("adding a mesh");
+    }
+
+    // A sphere is Embree user geometry whose test is prism's (transform, motion and all), over
+    // the world box prism's own index holds for it.
+    void add_sphere_object(std::uint32_t object) {
+        user_data_.push_back({this, object});
+        RTCGeometry geometry = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_USER);
+        rtcSetGeometryUserPrimitiveCount(geometry, 1);
+        rtcSetGeometryUserData(geometry, &user_data_.back());
+        rtcSetGeometryBoundsFunction(geometry, &sphere_bounds, nullptr);
+        rtcSetGeometryIntersectFunction(geometry, &sphere_intersect);
+        rtcSetGeometryOccludedFunction(geometry, &sphere_occluded);
+        rtcCommitGeometry(geometry);
+        rtcAttachGeometryByID(scene_.get(), geometry, object);
+        rtcReleaseGeometry(geometry);
+        check("adding a sphere");
+    }
+
+    static void sphere_bounds(const RTCBoundsFunctionArguments* args) {
+        const auto* data = static_cast<const SphereUserData*>(args->geometryUserPtr);
+        const Aabb<Real> box = data->self->shapes_.world_bounds(data->object);
+        // Rounded outwards to float, so the box still holds the sphere.
+        args->bounds_o->lower_x = next_down(float(box.min.x));
+        args->bounds_o->lower_y = next_down(float(box.min.y));
+        args->bounds_o->lower_z = next_down(float(box.min.z));
+        args->bounds_o->upper_x = next_up(float(box.max.x));
+        args->bounds_o->upper_y = next_up(float(box.max.y));
+        args->bounds_o->upper_z = next_up(float(box.max.z));
+    }
+
+    static void sphere_intersect(const RTCIntersectFunctionNArguments* args) {
+        if (!args->valid[0]) return;
+        const auto* data = static_cast<const SphereUserData*>(args->geometryUserPtr);
+        RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, args->N);
+        // The query's own ray in Real (Embree's copy is rounded to float: in double its origin
+        // could lie inside the sphere a ray just left); Embree keeps the closest so far.
+        Ray<Real> ray = *reinterpret_cast<const Context*>(args->context)->world_ray;
+        Hit<Real> hit;
+        if (!data->self->shapes_.intersect_primitive(data->object, 0, ray, hit)) return;
+        if (!(float(hit.t) <= RTCRayN_tfar(rays, args->N, 0))) return;
+        RTCRayN_tfar(rays, args->N, 0) = float(hit.t);
+        RTCHitN* embree_hit = RTCRayHitN_HitN(args->rayhit, args->N);
+        RTCHitN_geomID(embree_hit, args->N, 0) = data->object;
+        RTCHitN_primID(embree_hit, args->N, 0) = 0;
+        RTCHitN_u(embree_hit, args->N, 0) = 0;
+        RTCHitN_v(embree_hit, args->N, 0) = 0;
+        RTCHitN_instID(embree_hit, args->N, 0, 0) = args->context->instID[0];
+    }
+
+    static void sphere_occluded(const RTCOccludedFunctionNArguments* args) {
+        if (!args->valid[0]) return;
+        const auto* data = static_cast<const SphereUserData*>(args->geometryUserPtr);
+        Ray<Real> ray = *reinterpret_cast<const Context*>(args->context)->world_ray;
+        const Real t_max = ray.t_max;
+        Hit<Real> hit;
+        if (data->self->shapes_.intersect_primitive(data->object, 0, ray, hit) && hit.t < t_max)
+            RTCRayN_tfar(args->ray, args->N, 0) = -std::numeric_limits<float>::infinity();
+    }
+
+    // Camera rays with culling (geometry/backface_culling.hpp): a triangle whose winding faces
+    // away from the ray is no hit.
+    // prism culls where (v1 - v0) x (v2 - v0) . d > 0; Embree's Ng points the same way (tested
+    // against prism's own culling in tests/test_embree.cpp), ray and normal both in the
+    // triangle's object space.
+    // The context filter of a query: culling, then prism's test.
+    template <BackfaceCulling Culling, bool AnyHit>
+    static RTCFilterFunctionN filter_for() {
+        return &filter<Culling, AnyHit>;
+    }
+
+    template <BackfaceCulling Culling, bool AnyHit>
+    static void filter(const RTCFilterFunctionNArguments* args) {
+        if (!args->valid[0]) return;
+        const auto* context = reinterpret_cast<const Context*>(args->context);
+        const unsigned instance = RTCHitN_instID(args->hit, args->N, 0, 0);
+        const std::uint32_t object =
+            instance != RTC_INVALID_GEOMETRY_ID ? instance : RTCHitN_geomID(args->hit, args->N, 0);
+        if constexpr (Culling != BackfaceCulling::none) {
+            if (context->self->shapes_.culls(object, Culling)) cull_backfaces(args);
+            if (!args->valid[0]) return;
+        }
+        Ray<Real> ray = *context->world_ray;
+        const Real t_max = ray.t_max;
+        Hit<Real> hit;
+        const bool hit_by_prism =
+            context->self->shapes_.intersect_primitive(object, RTCHitN_primID(args->hit, args->N, 0), ray, hit);
+        if (!hit_by_prism || (AnyHit && !(hit.t < t_max))) args->valid[0] = 0;
+    }
+
+    static void cull_backfaces(const RTCFilterFunctionNArguments* args) {
+        const float dot = RTCRayN_dir_x(args->ray, args->N, 0) * RTCHitN_Ng_x(args->hit, args->N, 0) +
+                          RTCRayN_dir_y(args->ray, args->N, 0) * RTCHitN_Ng_y(args->hit, args->N, 0) +
+                          RTCRayN_dir_z(args->ray, args->N, 0) * RTCHitN_Ng_z(args->hit, args->N, 0);
+        if (dot > 0) args->valid[0] = 0;
+    }
+
+    Shapes shapes_;
+    DeviceHandle device_;
+    SceneHandle scene_;
+    std::vector<std::unique_ptr<SceneHandle>> mesh_scenes_;
+    std::vector<SphereUserData> user_data_;  // reserved up front: Embree keeps pointers into it
+};
+
+}  // namespace prism
