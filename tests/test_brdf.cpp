@@ -165,6 +165,43 @@ TEST_CASE_TEMPLATE("BRDFs: a material without one is hw1-hw5's Blinn-Phong", Rea
     }
 }
 
+TEST_CASE_TEMPLATE("BRDFs: Torrance-Sparrow's D, F and G at two hand-worked configurations", Real, float, double) {
+    // No course scene with an expected image uses Torrance-Sparrow, so its terms are checked here
+    // from the angles: n = +z, wi and wo in the xz plane at polar angles theta_i and theta_o.
+    const double eta = 1.5, r0 = 0.04, p = 20;  // R0 = ((1.5 - 1) / (1.5 + 1))^2
+    struct Case {
+        double theta_i, theta_o;  // degrees, on either side of n
+        double cos_alpha, cos_beta, geometry;
+    };
+    // Mirror configuration at 30 degrees: h = n, beta = 30 degrees, G = min(1, 2 cos^2 30 / cos 30) = 1.
+    // wi at 80, wo at 40 degrees on the same side: h at 60 degrees, beta = 20 degrees, and
+    // shadowing wins: G = 2 cos(60) cos(80) / cos(20) = 0.1848.
+    const double deg = pi / 180;
+    const Case cases[] = {{-30, 30, 1, std::cos(30 * deg), 1},
+                          {80, 40, std::cos(60 * deg), std::cos(20 * deg),
+                           2 * std::cos(60 * deg) * std::cos(80 * deg) / std::cos(20 * deg)}};
+    for (const bool kdfresnel : {false, true}) {
+        scene::Material description = course_material(brdf_of(scene::BrdfModel::torrance_sparrow, p, false, kdfresnel), eta);
+        description.diffuse = scene::Vec3(0.25);
+        description.specular = scene::Vec3(0.5);
+        const prism::Material<Real> material(description);
+        for (const Case& c : cases) {
+            CAPTURE(kdfresnel);
+            CAPTURE(c.theta_i);
+            const Vec3<Real> n(0, 0, 1);
+            const Vec3<Real> wi(Real(std::sin(c.theta_i * deg)), 0, Real(std::cos(c.theta_i * deg)));
+            const Vec3<Real> wo(Real(std::sin(c.theta_o * deg)), 0, Real(std::cos(c.theta_o * deg)));
+            const double distribution = (p + 2) / (2 * pi) * std::pow(c.cos_alpha, p);
+            const double fresnel = r0 + (1 - r0) * std::pow(1 - c.cos_beta, 5);
+            const double diffuse = 0.25 * (kdfresnel ? 1 - fresnel : 1) / pi;
+            const double expected = diffuse + 0.5 * distribution * fresnel * c.geometry /
+                                                  (4 * std::cos(c.theta_i * deg) * std::cos(c.theta_o * deg));
+            const Vec3<Real> f = prism::evaluate_brdf(material, n, wi, wo);
+            CHECK(double(f.x) == doctest::Approx(expected).epsilon(std::is_same_v<Real, float> ? 1e-5 : 1e-12));
+        }
+    }
+}
+
 TEST_CASE_TEMPLATE("BRDFs: the normalised models reflect at most what arrives", Real, float, double) {
     using M = scene::BrdfModel;
     const int cells = 600;
