@@ -765,6 +765,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: the hit interval is the same for triangles, s
 }
 
 TEST_CASE_TEMPLATE("SceneGeometry: back-face culling skips surfaces facing away, only when asked", Real, float, double) {
+    using prism::BackfaceCulling;
     scene::Scene world;
     world.materials.push_back({});
     scene::Mesh mesh;  // counter-clockwise seen from +z: faces +z
@@ -778,21 +779,76 @@ TEST_CASE_TEMPLATE("SceneGeometry: back-face culling skips surfaces facing away,
     const prism::Ray<Real> from_behind{prism::Vec3<Real>(0, 0, -10), prism::Vec3<Real>(0, 0, 1)};
     prism::Hit<Real> hit;
     prism::Ray<Real> ray = from_front;
-    REQUIRE(geometry.template intersect<true>(ray, hit));
+    REQUIRE(geometry.template intersect<BackfaceCulling::all>(ray, hit));
     CHECK(hit.t == Real(2));
     CHECK(hit.object == 0);
     ray = from_behind;
-    CHECK_FALSE(geometry.template intersect<true>(ray, hit));  // both the plane and the triangle face away
+    CHECK_FALSE(geometry.template intersect<BackfaceCulling::all>(ray, hit));  // both the plane and the triangle face away
     ray = from_behind;
-    REQUIRE(geometry.template intersect<false>(ray, hit));
+    REQUIRE(geometry.template intersect<BackfaceCulling::none>(ray, hit));
     CHECK(hit.t == Real(5));
     CHECK(hit.object == 1);  // planes are numbered after the instances
     ray = from_behind;
     ray.t_min = Real(6);
-    REQUIRE(geometry.template intersect<false>(ray, hit));
+    REQUIRE(geometry.template intersect<BackfaceCulling::none>(ray, hit));
     CHECK(hit.t == Real(10));
     CHECK(hit.object == 0);
+    // The course's rule skips the flat triangle but keeps the plane.
+    ray = from_behind;
+    ray.t_min = Real(6);
+    CHECK_FALSE(geometry.template intersect<BackfaceCulling::flat_triangles>(ray, hit));
+    ray = from_behind;
+    REQUIRE(geometry.template intersect<BackfaceCulling::flat_triangles>(ray, hit));
+    CHECK(hit.object == 1);
     });
+}
+
+TEST_CASE_TEMPLATE("SceneGeometry: the course's culling keeps smooth meshes and follows instances' transformations",
+                   Real, float, double) {
+    using prism::BackfaceCulling;
+    scene::Scene world;
+    world.materials.push_back({});
+    scene::Mesh flat;  // faces +z, at z = 0
+    flat.positions = {{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}};
+    flat.triangles = {{0, 1, 2}};
+    scene::Mesh smooth = flat;  // the same triangle at z = -1, smooth-shaded
+    smooth.shading = scene::ShadingMode::smooth;
+    for (auto& p : smooth.positions) p.z = -1;
+    world.meshes = {flat, smooth};
+    const prism::Ray<Real> from_behind{prism::Vec3<Real>(0, 0, -10), prism::Vec3<Real>(0, 0, 1)};
+    const prism::Ray<Real> from_front{prism::Vec3<Real>(0, 0, 10), prism::Vec3<Real>(0, 0, -1)};
+    prism::Hit<Real> hit;
+    {
+        const BvhGeometry<Real> geometry(world);
+        prism::Ray<Real> ray = from_behind;
+        // From behind the smooth triangle (t = 9) is met first and kept; flat and all differ.
+        REQUIRE(geometry.template intersect<BackfaceCulling::flat_triangles>(ray, hit));
+        CHECK(hit.t == Real(9));
+        CHECK(hit.object == 1);
+        ray = from_behind;
+        CHECK_FALSE(geometry.template intersect<BackfaceCulling::all>(ray, hit));
+        // From the front, nothing is culled: the flat triangle at t = 10 is nearer.
+        ray = from_front;
+        REQUIRE(geometry.template intersect<BackfaceCulling::flat_triangles>(ray, hit));
+        CHECK(hit.t == Real(10));
+        CHECK(hit.object == 0);
+    }
+    // An instance turned half around the y axis and moved to z = 1 faces -z: culled from the
+    // front, seen from behind, while the original at z = 0 (facing +z) does the opposite.
+    world.meshes.pop_back();
+    const glm::dmat4 turned = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0, 1)) *
+                              glm::rotate(glm::dmat4(1.0), 3.141592653589793, glm::dvec3(0, 1, 0));
+    world.mesh_instances.push_back({"turned", 0, 0, turned, {}, {}});
+    const BvhGeometry<Real> geometry(world);
+    prism::Ray<Real> ray = from_behind;
+    REQUIRE(geometry.template intersect<BackfaceCulling::flat_triangles>(ray, hit));
+    CHECK(hit.t == doctest::Approx(11).epsilon(1e-6));
+    ray = from_front;
+    REQUIRE(geometry.template intersect<BackfaceCulling::flat_triangles>(ray, hit));
+    CHECK(hit.t == doctest::Approx(10).epsilon(1e-6));
+    ray = from_front;
+    REQUIRE(geometry.template intersect<BackfaceCulling::none>(ray, hit));
+    CHECK(hit.t == doctest::Approx(9).epsilon(1e-6));
 }
 
 // ---------------------------------------------------------------------------------------------

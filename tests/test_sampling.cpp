@@ -246,7 +246,7 @@ TEST_CASE_TEMPLATE("Renderer: multisampled, lens, area-lit, glossy and moving im
     for (const auto& pixel : one.pixels) brightest = std::max(brightest, pixel.r);
     CHECK(brightest > 0.1f);
     // Another seed gives another image (the streams are really used).
-    const prism::Renderer<Complete> reseeded(world, prism::RendererSettings{false, prism::RayOffset::scene_epsilon, 99});
+    const prism::Renderer<Complete> reseeded(world, prism::RendererSettings{prism::BackfaceCulling::flat_triangles, prism::RayOffset::scene_epsilon, 99});
     CHECK(reseeded.render(world.cameras[0]).pixels != one.pixels);
 }
 

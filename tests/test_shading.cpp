@@ -308,7 +308,9 @@ TEST_CASE_TEMPLATE("Renderer: a mirror adds km times the radiance of the reflect
     SUBCASE("depth 2: own ambient plus km times the reflection, by hand") {
         check_relative(centre_pixel<Real>(world), own + mirror.mirror * reflected, 1e-4);
         // And km times what the renderer itself sees along the reflected ray.
-        const prism::Renderer<prism::Config<Real>> renderer(world);
+        // radiance() traces its ray as a camera ray, which skips the flat triangle's back face by
+        // default; the reflected ray sees it, so compare with the renderer that culls nothing.
+        const prism::Renderer<prism::Config<Real>> renderer(world, {prism::BackfaceCulling::none});
         const prism::Ray<Real> reflected_ray{prism::Vec3<Real>(0, 0, Real(-2 + world.shadow_ray_epsilon)),
                                              prism::Vec3<Real>(0, 0, 1)};
         check_relative(centre_pixel<Real>(world), own + mirror.mirror * glm::dvec3(renderer.radiance(reflected_ray)),
@@ -321,5 +323,50 @@ TEST_CASE_TEMPLATE("Renderer: a mirror adds km times the radiance of the reflect
     SUBCASE("a reflected ray that escapes brings nothing, not the background") {
         world.meshes.pop_back();
         check_relative(centre_pixel<Real>(world), own, 1e-4);
+    }
+}
+
+TEST_CASE_TEMPLATE("Renderer: camera rays skip a flat back face, as the course does, and see a smooth one",
+                   Real, float, double) {
+    // A small triangle at z = -1 wound to face away from the camera, between the camera and the
+    // lit triangle at z = -2, and clear of the lit point's shadow ray towards (1, 2, 0).
+    scene::Scene world = lit_scene();
+    scene::Material occluder_material = matte();
+    occluder_material.ambient = {0.9, 0.1, 0.1};
+    occluder_material.diffuse = {0.1, 0.6, 0.1};
+    world.materials.push_back(occluder_material);
+    scene::Mesh occluder;
+    occluder.material = 1;
+    occluder.positions = {{-0.5, -0.5, -1}, {0, 0.5, -1}, {0.5, -0.5, -1}};  // clockwise from the camera
+    occluder.triangles = {{0, 1, 2}};
+    world.meshes.push_back(occluder);
+
+    const glm::dvec3 lit = blinn_phong({0, 0, -2}, {0, 0, 1}, {0, 0, 1}, world.materials[0], world.point_lights[0],
+                                       world.ambient_light);
+    // Seen, the back face is shaded on the camera's side (normal +z), under the same light.
+    const glm::dvec3 back_face = blinn_phong({0, 0, -1}, {0, 0, 1}, {0, 0, 1}, occluder_material,
+                                             world.point_lights[0], world.ambient_light);
+    REQUIRE(glm::length(lit - back_face) > 10);  // the two outcomes are told apart
+
+    const auto centre = [&](prism::BackfaceCulling culling) {
+        const prism::Renderer<prism::Config<Real>> renderer(world, {culling});
+        return glm::dvec3(renderer.render(world.cameras[0])(1, 1));
+    };
+    SUBCASE("flat: the default skips it, --cull-backfaces too, --no-cull-backfaces shows it") {
+        check_relative(centre_pixel<Real>(world), lit, 1e-4);
+        check_relative(centre(prism::BackfaceCulling::flat_triangles), lit, 1e-4);
+        check_relative(centre(prism::BackfaceCulling::all), lit, 1e-4);
+        check_relative(centre(prism::BackfaceCulling::none), back_face, 1e-4);
+    }
+    SUBCASE("smooth: the default shows it, only --cull-backfaces skips it") {
+        world.meshes.back().shading = scene::ShadingMode::smooth;
+        check_relative(centre_pixel<Real>(world), back_face, 1e-4);
+        check_relative(centre(prism::BackfaceCulling::all), lit, 1e-4);
+    }
+    SUBCASE("turned to face the camera, it hides the lit triangle whatever the rule") {
+        std::swap(world.meshes.back().triangles[0][1], world.meshes.back().triangles[0][2]);
+        for (const auto culling : {prism::BackfaceCulling::none, prism::BackfaceCulling::flat_triangles,
+                                   prism::BackfaceCulling::all})
+            check_relative(centre(culling), back_face, 1e-4);
     }
 }

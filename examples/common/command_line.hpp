@@ -56,6 +56,10 @@ public:
             if (mode == "error-bound") options.ray_offset = RayOffset::error_bound;
             else if (mode == "scene-epsilon") options.ray_offset = RayOffset::scene_epsilon;
             else usage_error("--ray-offset must be error-bound or scene-epsilon");
+        } else if (option == "--cull-backfaces") {
+            options.backface_culling = BackfaceCulling::all;
+        } else if (option == "--no-cull-backfaces") {
+            options.backface_culling = BackfaceCulling::none;
         } else if (option == "--seed") {
             options.seed = number<std::uint64_t>(option, next_value());
         } else {

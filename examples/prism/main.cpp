@@ -1,18 +1,25 @@
 // prism: renders every camera of a CENG795 scene file (XML or JSON) into its image file.
 // All cameras are rendered before any file is written, so a failure leaves no partial output.
+// Every image goes inside --output-dir (io/output_path.hpp); Ctrl-C stops the render and writes
+// nothing, or, while files are being written, stops before the next file.
 #include "../common/command_line.hpp"
 
 #include <prism/image/image_io.hpp>
 #include <prism/image/tonemap.hpp>
+#include <prism/io/limits.hpp>
 #include <prism/io/load.hpp>
+#include <prism/io/output_path.hpp>
 #include <prism/render/progress.hpp>
 #include <prism/render/render_scene.hpp>
 
+#include <atomic>
 #include <charconv>
+#include <csignal>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
 #include <iostream>
+#include <new>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -31,7 +38,8 @@ image under the name the scene gives it (.png: clamped to 0-255; .exr: linear ra
 name's stem and the Tonemap's <Extension>; a .png image name with Tonemaps is tone-mapped itself.
 
 options:
-  --output-dir DIR     folder for the images (default: the current folder); created if missing
+  --output-dir DIR     folder for the images (default: the current folder); created if missing.
+                       An ImageName that is absolute or leaves DIR (`..`, a link) is refused
   --threads N          worker threads (default: all hardware threads)
   --precision P        float | double-refine | double: override the precision chosen from the
                        scene (the choice and its reason are printed)
@@ -47,12 +55,23 @@ options:
                        as the course's images of 2021-2025 scenes show; the default) or
                        reflect (a mirror, as 2017-2019 scene files, written before material
                        types existed, mean it)
-  --cull-backfaces     primary rays ignore triangles facing away from the camera
+  --cull-backfaces     camera rays ignore every triangle and plane facing away from them
+  --no-cull-backfaces  camera rays see every surface from both sides. Default (neither): the
+                       course's rule, camera rays ignore back-facing triangles of flat-shaded
+                       meshes and see smooth-shaded meshes, spheres and planes from both sides
+  --max-recursion-depth N
+                       the largest MaxRecursionDepth a scene may ask for (default 64; at most
+                       512, the depth the renderer's stack is known to hold)
   --quiet              print nothing but errors
   --help               this text
 
+Ctrl-C during the render stops it and writes nothing; during writing, the images already written
+stay (each complete: images are written to a temporary file and renamed into place) and no
+further one is started. A second Ctrl-C ends prism at once.
+
 exit status: 0 on success; 1 when the scene cannot be loaded, rendered or written (one line on
-stderr names the file and the element at fault, and no image is written); 2 for usage errors.
+stderr names the file and the element at fault, and no image is written); 2 for usage errors;
+130 when interrupted.
 )";
 
 struct Arguments {
@@ -84,8 +103,12 @@ Arguments parse_arguments(int argc, char** argv) {
             if (mode == "reflect") arguments.load.untyped_mirrors_reflect = true;
             else if (mode == "ignore") arguments.load.untyped_mirrors_reflect = false;
             else command_line.usage_error("--untyped-mirrors must be reflect or ignore");
-        } else if (arg == "--cull-backfaces") {
-            arguments.options.cull_backfaces = true;
+        } else if (arg == "--max-recursion-depth") {
+            const int depth = command_line.number<int>(arg, value());
+            if (depth < 0 || depth > prism::io::stack_safe_recursion_depth)
+                command_line.usage_error("--max-recursion-depth must be between 0 and " +
+                                         std::to_string(prism::io::stack_safe_recursion_depth));
+            arguments.load.limits.max_recursion_depth = depth;
         } else if (arg == "--quiet") {
             arguments.quiet = true;
         } else if (!arg.empty() && arg[0] == '-') {
@@ -100,6 +123,17 @@ Arguments parse_arguments(int argc, char** argv) {
     return arguments;
 }
 
+// Ctrl-C: the first one asks the render to stop (checked after every tile) and restores the
+// default action, so that a second one ends the program at once.
+std::atomic<bool> interrupted{false};
+
+extern "C" void on_interrupt(int) {
+    interrupted.store(true);
+    std::signal(SIGINT, SIG_DFL);
+}
+
+struct Interrupted {};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -110,10 +144,25 @@ int main(int argc, char** argv) {
         const prism::scene::Scene scene = prism::io::load_scene(arguments.scene, arguments.load);
         if (scene.cameras.empty()) throw prism::io::LoadError(arguments.scene, "<Cameras>", "the scene has no camera");
 
+        // Every output's place is checked before the render, so a refused name costs no render time.
+        std::vector<std::vector<std::filesystem::path>> paths;
+        for (const prism::scene::Camera& camera : scene.cameras) {
+            const std::string element = prism::io::element_label("Camera", &camera.id) + "/<ImageName>";
+            paths.emplace_back();
+            for (const prism::CameraOutput& output : prism::camera_outputs(camera))
+                paths.back().push_back(
+                    prism::io::confined_output_path(arguments.output_dir, output.name, arguments.scene, element));
+        }
+
         const std::size_t total_pixels = prism::total_pixels(scene, arguments.options);
         prism::ProgressBar progress(total_pixels, !arguments.quiet);
-        const auto images = prism::render_scene(scene, arguments.options, log,
-                                                [&](std::size_t, int pixels) { progress.advance(std::size_t(pixels)); });
+        std::signal(SIGINT, on_interrupt);
+        // An exception thrown from a tile cancels the parallel render and reaches this thread.
+        const auto images = prism::render_scene(scene, arguments.options, log, [&](std::size_t, int pixels) {
+            if (interrupted.load()) throw Interrupted{};
+            progress.advance(std::size_t(pixels));
+        });
+        if (interrupted.load()) throw Interrupted{};
         progress.finish();
 
         for (const auto& rendered : images) {
@@ -121,15 +170,29 @@ int main(int argc, char** argv) {
             log << "camera " << camera.id << ": " << rendered.image.width << "x" << rendered.image.height
                 << " rendered in " << rendered.seconds << " s\n";
             // Every file of the camera comes from this one render: no tone mapping re-traces.
-            for (const prism::CameraOutput& output : prism::camera_outputs(camera)) {
-                const std::filesystem::path path = arguments.output_dir / output.name;
+            const std::vector<prism::CameraOutput> outputs = prism::camera_outputs(camera);
+            for (std::size_t o = 0; o < outputs.size(); ++o) {
+                if (interrupted.load()) throw Interrupted{};
+                const prism::CameraOutput& output = outputs[o];
+                const std::filesystem::path& path = paths[rendered.camera][o];
                 if (output.tonemap) prism::write_image(path, prism::tone_map(rendered.image, camera.tonemaps[*output.tonemap]));
                 else prism::write_image(path, rendered.image);
                 log << "  " << path.string() << '\n';
             }
         }
-    } catch (const std::exception& error) {
+    } catch (const Interrupted&) {
+        std::cerr << "prism: interrupted (Ctrl-C): the images written before it are complete, no other was written\n";
+        return 130;
+    } catch (const prism::io::LoadError& error) {
         std::cerr << "prism: " << error.what() << '\n';
+        return 1;
+    } catch (const std::bad_alloc&) {
+        // The limits (io/limits.hpp) keep a scene's own requests in bounds; this is the machine
+        // running out of memory for what is left (a large mesh, many threads' worth of tiles).
+        std::cerr << "prism: " << arguments.scene.string() << ": out of memory while loading or rendering the scene\n";
+        return 1;
+    } catch (const std::exception& error) {
+        std::cerr << "prism: " << arguments.scene.string() << ": " << error.what() << '\n';
         return 1;
     }
     return 0;

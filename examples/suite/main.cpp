@@ -70,6 +70,9 @@ options:
   --ray-offset M       scene-epsilon | error-bound: how rays leave surfaces (default: as
                        prism chooses from the scene)
   --seed N             selects the pixels' random streams (default 0)
+  --cull-backfaces     camera rays ignore every triangle and plane facing away from them
+  --no-cull-backfaces  camera rays see every surface from both sides (default: the course's
+                       rule, back-facing triangles of flat-shaded meshes only)
   --verbose            print the renderer's log (configuration, build times) on stderr
   --help               this text
 

@@ -47,16 +47,17 @@ public:
         tree.primitive_indices_.resize(count);
         std::iota(tree.primitive_indices_.begin(), tree.primitive_indices_.end(), 0u);
         if (count == 0) return tree;
-        std::vector<Vec3<Real>> centroids(count);
-        Aabb<Real> root_bounds;
+        std::vector<BuildBox> build_boxes(count);
+        Aabb<Real> root_bounds, centroid_bounds;
         for (std::uint32_t i = 0; i < count; ++i) {
-            centroids[i] = boxes[i].centroid();
+            build_boxes[i] = BuildBox::of(boxes[i]);
             root_bounds.extend(boxes[i]);
+            centroid_bounds.extend(boxes[i].centroid());
         }
         tree.nodes_.resize(2 * std::size_t(count) - 1);
         tree.nodes_[0].bounds = root_bounds;
-        Builder builder{boxes, centroids, tree.primitive_indices_, tree.nodes_, options, {1}};
-        builder.build(0, 0, count, 0);
+        Builder builder{build_boxes, tree.primitive_indices_, tree.nodes_, options, {1}};
+        builder.build(0, 0, count, centroid_bounds, 0);
         tree.nodes_.resize(builder.node_count.load());
         tree.nodes_.shrink_to_fit();
         return tree;
@@ -132,17 +133,57 @@ private:
         return node.is_leaf() ? 1 : 1 + std::max(depth_of(node.index), depth_of(node.index + 1));
     }
 
+    // A box as the builder reads it: four lanes per corner (the fourth unused), contiguous and in
+    // the order of primitive_indices, so every pass over a node reads one range instead of
+    // gathering boxes through the indices (a cache miss per primitive per level once the
+    // partitions have scrambled the order), and the compiler can take each corner's minimum or
+    // maximum as one 4-wide operation. The partitions permute boxes and indices together.
+    struct BuildBox {
+        std::array<Real, 4> min, max;
+
+        static BuildBox of(const Aabb<Real>& box) {
+            return {{box.min.x, box.min.y, box.min.z, Real(0)}, {box.max.x, box.max.y, box.max.z, Real(0)}};
+        }
+        Aabb<Real> aabb() const { return {{min[0], min[1], min[2]}, {max[0], max[1], max[2]}}; }
+        // As Aabb::centroid computes it, so bins and partitions see the same centroids.
+        Real centroid(int axis) const { return (min[axis] + max[axis]) * Real(0.5); }
+        Vec3<Real> centroid() const { return {centroid(0), centroid(1), centroid(2)}; }
+        // glm::min(min, other.min), lane by lane: the same operand order, so the same results.
+        void extend(const BuildBox& other) {
+            for (int k = 0; k < 4; ++k) {
+                min[k] = other.min[k] < min[k] ? other.min[k] : min[k];
+                max[k] = max[k] < other.max[k] ? other.max[k] : max[k];
+            }
+        }
+        static BuildBox empty() {
+            return {{infinity<Real>, infinity<Real>, infinity<Real>, infinity<Real>},
+                    {-infinity<Real>, -infinity<Real>, -infinity<Real>, -infinity<Real>}};
+        }
+    };
+
     struct Builder {
-        std::span<const Aabb<Real>> boxes;
-        const std::vector<Vec3<Real>>& centroids;
+        std::vector<BuildBox>& boxes;  // in the order of indices
         std::vector<std::uint32_t>& indices;
         std::vector<BvhNode<Real>>& nodes;
         const BvhBuildOptions& options;
         std::atomic<std::uint32_t> node_count;
 
-        struct Bin {
-            Aabb<Real> bounds;
-            std::uint32_t count = 0;
+        static constexpr int max_bins = 64;
+        // Below this many primitives one set of bins is used (resetting and merging a second
+        // costs more than the stalls it saves).
+        static constexpr std::uint32_t two_bin_sets_from = 64;
+
+        struct BinSet {
+            std::array<std::array<BuildBox, max_bins>, 3> bounds;
+            std::array<std::array<std::uint32_t, max_bins>, 3> counts;
+
+            void reset(int bin_count) {
+                for (int axis = 0; axis < 3; ++axis)
+                    for (int b = 0; b < bin_count; ++b) {
+                        bounds[axis][b] = BuildBox::empty();
+                        counts[axis][b] = 0;
+                    }
+            }
         };
 
         void make_leaf(std::uint32_t node, std::uint32_t begin, std::uint32_t end) {
@@ -150,45 +191,91 @@ private:
             nodes[node].count = end - begin;
         }
 
-        void build(std::uint32_t node, std::uint32_t begin, std::uint32_t end, int depth) {
+        // `centroid_bounds` bounds the centroids of the primitives in [begin, end): the
+        // parent's partition measured it, which saves a pass over the range per node.
+        void build(std::uint32_t node, std::uint32_t begin, std::uint32_t end, const Aabb<Real>& centroid_bounds,
+                   int depth) {
             const std::uint32_t count = end - begin;
             // Leave room on the traversal stack: past max_depth - 1, stop splitting.
             if (count <= 1 || depth >= max_depth - 2) return make_leaf(node, begin, end);
+            const BuildBox* const range = boxes.data() + begin;
 
-            Aabb<Real> centroid_bounds;
-            for (std::uint32_t i = begin; i < end; ++i) centroid_bounds.extend(centroids[indices[i]]);
+            const int bin_count = std::min(options.bin_count, max_bins);
+            std::array<bool, 3> splittable{};
+            std::array<Real, 4> low{}, scale{};  // four lanes, as the boxes
+            for (int axis = 0; axis < 3; ++axis) {
+                splittable[axis] = centroid_bounds.max[axis] > centroid_bounds.min[axis];
+                low[axis] = centroid_bounds.min[axis];
+                if (splittable[axis])
+                    scale[axis] = Real(bin_count) / (centroid_bounds.max[axis] - centroid_bounds.min[axis]);
+            }
+            const auto bin_of = [&](const BuildBox& box, int axis) {
+                return std::min(bin_count - 1, int((box.centroid(axis) - low[axis]) * scale[axis]));
+            };
+            // The same bins on every axis at once, lane by lane (vectorised by the compiler). An
+            // axis that cannot be split puts everything in bin 0; so does a NaN centroid (an
+            // empty box, e.g. an instance of an empty mesh), which converts to INT_MIN on x86.
+            const auto bins_of = [&](const BuildBox& box) {
+                std::array<int, 4> bin;
+                for (int k = 0; k < 4; ++k) bin[k] = int((box.centroid(k) - low[k]) * scale[k]);
+                for (int k = 0; k < 4; ++k) bin[k] = bin[k] < bin_count - 1 ? bin[k] : bin_count - 1;
+                for (int k = 0; k < 4; ++k) bin[k] = bin[k] > 0 ? bin[k] : 0;
+                return bin;
+            };
 
-            const int bin_count = options.bin_count;
+            // All three axes are binned in one pass over the range (one read of each box, not
+            // three). In large nodes even and odd primitives go to separate sets of bins, merged
+            // afterwards: neighbours often fall in the same bin, and with one set each update
+            // waits for the previous one's store. Minimum, maximum and count do not depend on
+            // the order, so the bins (and the tree) are the same.
+            const auto add = [&](BinSet& set, const BuildBox& box) {
+                const std::array<int, 4> bin = bins_of(box);
+                for (int axis = 0; axis < 3; ++axis) {
+                    const int b = bin[axis];
+                    set.bounds[axis][b].extend(box);
+                    ++set.counts[axis][b];
+                }
+            };
+            BinSet bins, odd_bins;
+            bins.reset(bin_count);
+            if (count >= two_bin_sets_from) {
+                odd_bins.reset(bin_count);
+                std::uint32_t i = 0;
+                for (; i + 1 < count; i += 2) {
+                    add(bins, range[i]);
+                    add(odd_bins, range[i + 1]);
+                }
+                if (i < count) add(bins, range[i]);
+                for (int axis = 0; axis < 3; ++axis)
+                    for (int b = 0; b < bin_count; ++b) {
+                        bins.bounds[axis][b].extend(odd_bins.bounds[axis][b]);
+                        bins.counts[axis][b] += odd_bins.counts[axis][b];
+                    }
+            } else {
+                for (std::uint32_t i = 0; i < count; ++i) add(bins, range[i]);
+            }
+
             int best_axis = -1, best_split = 0;
             Real best_cost = infinity<Real>;
             Aabb<Real> best_left, best_right;
             for (int axis = 0; axis < 3; ++axis) {
-                const Real lo = centroid_bounds.min[axis], hi = centroid_bounds.max[axis];
-                if (!(hi > lo)) continue;
-                const Real scale = Real(bin_count) / (hi - lo);
-                std::array<Bin, 64> bins{};
-                for (std::uint32_t i = begin; i < end; ++i) {
-                    const std::uint32_t p = indices[i];
-                    const int b = std::min(bin_count - 1, int((centroids[p][axis] - lo) * scale));
-                    bins[b].bounds.extend(boxes[p]);
-                    ++bins[b].count;
-                }
+                if (!splittable[axis]) continue;
                 // Sweep from the right, then from the left, evaluating every plane between bins.
-                std::array<Real, 64> right_cost{};
-                std::array<Aabb<Real>, 64> right_bounds{};
+                std::array<Real, max_bins> right_cost;
+                std::array<Aabb<Real>, max_bins> right_bounds;
                 Aabb<Real> accumulated;
                 std::uint32_t accumulated_count = 0;
                 for (int b = bin_count - 1; b > 0; --b) {
-                    accumulated.extend(bins[b].bounds);
-                    accumulated_count += bins[b].count;
+                    accumulated.extend(bins.bounds[axis][b].aabb());
+                    accumulated_count += bins.counts[axis][b];
                     right_bounds[b] = accumulated;
                     right_cost[b] = accumulated.half_area() * Real(accumulated_count);
                 }
                 accumulated = {};
                 accumulated_count = 0;
                 for (int b = 0; b < bin_count - 1; ++b) {
-                    accumulated.extend(bins[b].bounds);
-                    accumulated_count += bins[b].count;
+                    accumulated.extend(bins.bounds[axis][b].aabb());
+                    accumulated_count += bins.counts[axis][b];
                     const Real cost = accumulated.half_area() * Real(accumulated_count) + right_cost[b + 1];
                     if (accumulated_count > 0 && accumulated_count < count && cost < best_cost) {
                         best_cost = cost;
@@ -205,23 +292,24 @@ private:
             const Real split_cost =
                 Real(options.traversal_cost) + (node_area > 0 ? best_cost / node_area : Real(count));
             std::uint32_t middle;
+            Aabb<Real> left_centroids, right_centroids;
             if (best_axis < 0) {
                 // All centroids coincide: SAH cannot separate them; split by count if too many.
                 if (count <= options.max_leaf_size) return make_leaf(node, begin, end);
                 middle = begin + count / 2;
                 best_left = {};
                 best_right = {};
-                for (std::uint32_t i = begin; i < middle; ++i) best_left.extend(boxes[indices[i]]);
-                for (std::uint32_t i = middle; i < end; ++i) best_right.extend(boxes[indices[i]]);
+                for (std::uint32_t i = begin; i < middle; ++i) best_left.extend(boxes[i].aabb());
+                for (std::uint32_t i = middle; i < end; ++i) best_right.extend(boxes[i].aabb());
+                left_centroids = right_centroids = centroid_bounds;  // all the same point
             } else {
                 if (count <= options.max_leaf_size && leaf_cost <= split_cost) return make_leaf(node, begin, end);
-                const Real lo = centroid_bounds.min[best_axis];
-                const Real scale = Real(bin_count) / (centroid_bounds.max[best_axis] - lo);
-                const auto in_left = [&](std::uint32_t p) {
-                    return std::min(bin_count - 1, int((centroids[p][best_axis] - lo) * scale)) < best_split;
+                const auto goes_left = [&](const BuildBox& box) {
+                    const bool left = bin_of(box, best_axis) < best_split;
+                    (left ? left_centroids : right_centroids).extend(box.centroid());
+                    return left;
                 };
-                middle = std::uint32_t(std::partition(indices.begin() + begin, indices.begin() + end, in_left) -
-                                       indices.begin());
+                middle = begin + partition(begin, end, goes_left);
             }
 
             const std::uint32_t left = node_count.fetch_add(2);
@@ -230,11 +318,34 @@ private:
             nodes[left].bounds = best_left;
             nodes[left + 1].bounds = best_right;
             if (count >= options.parallel_threshold) {
-                tbb::parallel_invoke([&] { build(left, begin, middle, depth + 1); },
-                                     [&] { build(left + 1, middle, end, depth + 1); });
+                tbb::parallel_invoke([&] { build(left, begin, middle, left_centroids, depth + 1); },
+                                     [&] { build(left + 1, middle, end, right_centroids, depth + 1); });
             } else {
-                build(left, begin, middle, depth + 1);
-                build(left + 1, middle, end, depth + 1);
+                build(left, begin, middle, left_centroids, depth + 1);
+                build(left + 1, middle, end, right_centroids, depth + 1);
+            }
+        }
+
+        // Moves the primitives of [begin, end) for which goes_left holds to the front, boxes and
+        // indices together, and returns how many there are; goes_left sees each primitive once.
+        // The swaps are those of libstdc++'s std::partition (Hoare's scheme from both ends),
+        // which this builder used before, so the primitive order is unchanged.
+        template <class GoesLeft>
+        std::uint32_t partition(std::uint32_t begin, std::uint32_t end, const GoesLeft& goes_left) {
+            std::uint32_t first = begin, last = end;
+            for (;;) {
+                for (;; ++first) {
+                    if (first == last) return first - begin;
+                    if (!goes_left(boxes[first])) break;
+                }
+                --last;
+                for (;; --last) {
+                    if (first == last) return first - begin;
+                    if (goes_left(boxes[last])) break;
+                }
+                std::swap(boxes[first], boxes[last]);
+                std::swap(indices[first], indices[last]);
+                ++first;
             }
         }
     };

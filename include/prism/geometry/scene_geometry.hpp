@@ -10,6 +10,7 @@
 #pragma once
 
 #include <prism/accel/accelerator.hpp>
+#include <prism/geometry/backface_culling.hpp>
 #include <prism/geometry/hit.hpp>
 #include <prism/geometry/sphere.hpp>
 #include <prism/geometry/surface_error.hpp>
@@ -95,7 +96,9 @@ public:
     Aabb<Real> bounds() const { return top_.bounds(); }
 
     // Closest hit in (ray.t_min, ray.t_max]; on a hit, ray.t_max becomes the hit distance.
-    template <bool CullBackfaces = false>
+    // `Culling` names the surfaces skipped when the ray meets them from behind
+    // (geometry/backface_culling.hpp).
+    template <BackfaceCulling Culling = BackfaceCulling::none>
     bool intersect(Ray<Real>& ray, Hit<Real>& hit) const {
         bool found = false;
         const auto& order = top_.primitive_indices();
@@ -103,7 +106,7 @@ public:
             bool leaf_hit = false;
             for (std::uint32_t i = first; i < first + count; ++i) {
                 const std::uint32_t object = order[i];
-                if (intersect_instance<CullBackfaces>(instances_[object], ray, t_max, hit)) {
+                if (intersect_instance<Culling>(instances_[object], ray, t_max, hit)) {
                     hit.object = object;
                     leaf_hit = true;
                 }
@@ -114,7 +117,7 @@ public:
         for (std::size_t p = 0; p < planes_.size(); ++p) {
             Real t;
             if (planes_[p].intersect(ray, ray.t_min, ray.t_max, t)) {
-                if constexpr (CullBackfaces) {
+                if constexpr (Culling == BackfaceCulling::all) {
                     if (glm::dot(ray.direction, planes_[p].normal) > 0) continue;
                 }
                 ray.t_max = t;
@@ -311,10 +314,14 @@ private:
         return instance.transformed ? instance.to_object(ray) : ray;
     }
 
-    template <bool CullBackfaces>
+    template <BackfaceCulling Culling>
     bool intersect_instance(const Instance& instance, const Ray<Real>& ray, Real& t_max, Hit<Real>& hit) const {
         const Ray<Real> local = to_object(instance, ray);
-        if (instance.kind == Kind::mesh) return meshes_[instance.shape].template intersect<CullBackfaces>(local, t_max, hit);
+        if (instance.kind == Kind::mesh) {
+            const auto& mesh = meshes_[instance.shape];
+            const bool cull = Culling == BackfaceCulling::all || (Culling == BackfaceCulling::flat_triangles && !mesh.smooth());
+            return cull ? mesh.template intersect<true>(local, t_max, hit) : mesh.template intersect<false>(local, t_max, hit);
+        }
         Real t;
         if (!spheres_[instance.shape].intersect(local, ray.t_min, t_max, t)) return false;
         t_max = t;

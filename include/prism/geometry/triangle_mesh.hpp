@@ -65,6 +65,7 @@ public:
 
     Aabb<Real> bounds() const { return bounds_; }
     std::size_t triangle_count() const { return triangle_count_; }
+    bool smooth() const { return smooth_; }  // shadingMode="smooth": normals interpolated from the vertices
 
     // Closest hit along `ray` (object space) below t_max; lowers t_max and fills t, primitive,
     // barycentrics. Culling skips triangles whose winding faces away from the ray.

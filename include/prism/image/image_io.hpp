@@ -4,6 +4,7 @@
 #pragma once
 
 #include <prism/image/image.hpp>
+#include <prism/io/limits.hpp>
 #include <prism/io/load_error.hpp>
 
 #include <stb_image.h>
@@ -18,7 +19,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <limits>
 #include <string>
+#include <string_view>
 #include <system_error>
 #include <vector>
 
@@ -161,55 +165,152 @@ inline void write_image(const std::filesystem::path& path, const Image& image) {
     }
 }
 
-// Reads an image into linear floats on the renderer's scale: 8-bit formats give 0..255 (the
-// values the course's PNGs hold), .hdr and .exr give their stored radiance unchanged.
-inline Image read_image(const std::filesystem::path& path) {
-    const std::string extension = detail::lowercase_extension(path);
-    std::error_code error;
-    if (!std::filesystem::is_regular_file(path, error))
-        throw io::LoadError(path, "", "no such image file");
+namespace detail {
 
-    Image image;
-    if (extension == ".exr") {
-        float* rgba = nullptr;
-        const char* message = nullptr;
-        if (LoadEXR(&rgba, &image.width, &image.height, path.c_str(), &message) != TINYEXR_SUCCESS) {
-            const std::string what = message ? message : "cannot read the EXR file";
-            if (message) FreeEXRErrorMessage(message);
-            throw io::LoadError(path, "", what);
-        }
-        image.pixels.resize(std::size_t(image.width) * std::size_t(image.height));
-        for (std::size_t i = 0; i < image.pixels.size(); ++i)
-            image.pixels[i] = glm::vec3(rgba[4 * i], rgba[4 * i + 1], rgba[4 * i + 2]);
-        std::free(rgba);  // LoadEXR allocates with malloc
-        return image;
+// The image's size, checked against the limits before anything is decoded: a file's header can
+// claim any size, and the decoders would allocate it.
+inline void check_image_size(const std::filesystem::path& path, std::int64_t width, std::int64_t height,
+                             std::int64_t max_pixels) {
+    if (width <= 0 || height <= 0)
+        throw io::LoadError(path, "", "the image has no pixels (" + std::to_string(width) + " x " +
+                                          std::to_string(height) + ")");
+    if (width > io::max_image_side || height > io::max_image_side || width * height > max_pixels)
+        throw io::LoadError(path, "", "the image is " + std::to_string(width) + " x " + std::to_string(height) +
+                                          " pixels; prism reads at most " + std::to_string(io::max_image_side) +
+                                          " per side and " + std::to_string(max_pixels) + " in all");
+}
+
+// OpenEXR through tinyexr's header-then-image calls (not LoadEXRFromMemory), so that the data
+// window is checked before the pixels are allocated and every path frees what tinyexr allocated.
+inline Image decode_exr(std::string_view bytes, const std::filesystem::path& path, std::int64_t max_pixels) {
+    const auto* memory = reinterpret_cast<const unsigned char*>(bytes.data());
+    const char* message = nullptr;
+    const auto fail = [&](const char* fallback) {
+        const std::string what = message ? message : fallback;
+        if (message) FreeEXRErrorMessage(message);
+        return io::LoadError(path, "", what);
+    };
+    EXRVersion version;
+    if (ParseEXRVersionFromMemory(&version, memory, bytes.size()) != TINYEXR_SUCCESS)
+        throw io::LoadError(path, "", "not an OpenEXR file");
+    if (version.multipart || version.non_image) throw io::LoadError(path, "", "multi-part and deep EXR files are not supported");
+    EXRHeader header;
+    InitEXRHeader(&header);
+    if (ParseEXRHeaderFromMemory(&header, &version, memory, bytes.size(), &message) != TINYEXR_SUCCESS) {
+        FreeEXRHeader(&header);
+        throw fail("cannot read the EXR header");
     }
+    struct HeaderGuard {
+        EXRHeader& header;
+        ~HeaderGuard() { FreeEXRHeader(&header); }
+    } header_guard{header};
+    check_image_size(path, std::int64_t(header.data_window.max_x) - header.data_window.min_x + 1,
+                     std::int64_t(header.data_window.max_y) - header.data_window.min_y + 1, max_pixels);
+    int channel_of[3] = {-1, -1, -1};  // R, G, B; a single channel (Y or anything) is grey
+    for (int c = 0; c < header.num_channels; ++c) {
+        if (header.pixel_types[c] == TINYEXR_PIXELTYPE_HALF) header.requested_pixel_types[c] = TINYEXR_PIXELTYPE_FLOAT;
+        const std::string_view name = header.channels[c].name;
+        if (name == "R") channel_of[0] = c;
+        else if (name == "G") channel_of[1] = c;
+        else if (name == "B") channel_of[2] = c;
+    }
+    if (header.num_channels == 1) channel_of[0] = channel_of[1] = channel_of[2] = 0;
+    if (channel_of[0] < 0 || channel_of[1] < 0 || channel_of[2] < 0)
+        throw io::LoadError(path, "", "the EXR file has no R, G and B channels");
+    for (int c : channel_of)
+        if (header.requested_pixel_types[c] != TINYEXR_PIXELTYPE_FLOAT)
+            throw io::LoadError(path, "", "the EXR file's colour channels are not floating point");
+
+    EXRImage exr;
+    InitEXRImage(&exr);
+    // On failure tinyexr frees the image itself, leaving its pointers dangling: no FreeEXRImage
+    // here. Its scanline decoder sets num_channels only on success, so its own clean-up would
+    // free no channel buffer of a file that fails half-way (a leak found by fuzzing); setting the
+    // count first lets it free them.
+    exr.num_channels = header.num_channels;
+    if (LoadEXRImageFromMemory(&exr, &header, memory, bytes.size(), &message) != TINYEXR_SUCCESS)
+        throw fail("cannot read the EXR file");
+    struct ImageGuard {
+        EXRImage& exr;
+        ~ImageGuard() { FreeEXRImage(&exr); }
+    } image_guard{exr};
+    Image image;
+    image.width = exr.width;
+    image.height = exr.height;
+    check_image_size(path, image.width, image.height, max_pixels);
+    image.pixels.resize(std::size_t(image.width) * std::size_t(image.height));
+    const auto store = [&](float* const* planes, int width, int height, int x0, int y0) {
+        for (int y = 0; y < height; ++y)
+            for (int x = 0; x < width; ++x) {
+                if (x0 + x >= image.width || y0 + y >= image.height) continue;
+                const std::size_t source = std::size_t(y) * std::size_t(width) + std::size_t(x);
+                image.pixels[std::size_t(y0 + y) * std::size_t(image.width) + std::size_t(x0 + x)] =
+                    glm::vec3(planes[channel_of[0]][source], planes[channel_of[1]][source], planes[channel_of[2]][source]);
+            }
+    };
+    if (header.tiled) {
+        for (int t = 0; t < exr.num_tiles; ++t) {
+            const EXRTile& tile = exr.tiles[t];
+            store(reinterpret_cast<float* const*>(tile.images), header.tile_size_x, header.tile_size_y,
+                  tile.offset_x * header.tile_size_x, tile.offset_y * header.tile_size_y);
+        }
+    } else {
+        store(reinterpret_cast<float* const*>(exr.images), image.width, image.height, 0, 0);
+    }
+    return image;
+}
+
+}  // namespace detail
+
+// Decodes an image file's bytes already in memory into linear floats on the renderer's scale:
+// 8-bit formats give 0..255 (the values the course's PNGs hold), .hdr and .exr their stored
+// radiance unchanged. The extension of `path` chooses the format; `path` names the file in
+// messages. Images past io::max_image_side per side or `max_pixels` in all are refused unread.
+inline Image decode_image(std::string_view bytes, const std::filesystem::path& path,
+                          std::int64_t max_pixels = io::max_image_pixels) {
+    const std::string extension = detail::lowercase_extension(path);
+    if (extension == ".exr") return detail::decode_exr(bytes, path, max_pixels);
 
     const bool is_hdr = extension == ".hdr";
     const bool is_ldr = extension == ".png" || extension == ".jpg" || extension == ".jpeg" || extension == ".bmp" ||
                         extension == ".tga" || extension == ".ppm" || extension == ".pgm";
     if (!is_hdr && !is_ldr) throw io::LoadError(path, "", "unsupported image format '" + extension + "'");
+    // stb takes an int length.
+    if (bytes.size() > std::size_t(std::numeric_limits<int>::max()))
+        throw io::LoadError(path, "", "the file is larger than 2 GiB");
+    const auto* memory = reinterpret_cast<const stbi_uc*>(bytes.data());
+    const int length = int(bytes.size());
 
+    Image image;
     int channels = 0;
-    if (is_hdr) {
-        // stbi_loadf, not stbi_load: .hdr holds linear radiance that must not be squeezed to 8 bits.
-        float* data = stbi_loadf(path.c_str(), &image.width, &image.height, &channels, 3);
-        if (!data) throw io::LoadError(path, "", "cannot read the image: " + detail::stb_failure());
-        image.pixels.resize(std::size_t(image.width) * std::size_t(image.height));
-        for (std::size_t i = 0; i < image.pixels.size(); ++i)
-            image.pixels[i] = glm::vec3(data[3 * i], data[3 * i + 1], data[3 * i + 2]);
-        stbi_image_free(data);
-    } else {
-        // stbi_load, not stbi_loadf: stbi_loadf would undo an assumed 2.2 gamma on 8-bit files,
-        // while the suite needs the stored byte values unchanged.
-        unsigned char* data = stbi_load(path.c_str(), &image.width, &image.height, &channels, 3);
+    if (!stbi_info_from_memory(memory, length, &image.width, &image.height, &channels))
+        throw io::LoadError(path, "", "cannot read the image: " + detail::stb_failure());
+    detail::check_image_size(path, image.width, image.height, max_pixels);
+    const auto copy = [&](const auto* data) {
         if (!data) throw io::LoadError(path, "", "cannot read the image: " + detail::stb_failure());
         image.pixels.resize(std::size_t(image.width) * std::size_t(image.height));
         for (std::size_t i = 0; i < image.pixels.size(); ++i)
             image.pixels[i] = glm::vec3(float(data[3 * i]), float(data[3 * i + 1]), float(data[3 * i + 2]));
-        stbi_image_free(data);
-    }
+        stbi_image_free(const_cast<void*>(static_cast<const void*>(data)));
+    };
+    // stbi_loadf for .hdr: linear radiance must not be squeezed to 8 bits. stbi_load, not
+    // stbi_loadf, for 8-bit files: stbi_loadf would undo an assumed 2.2 gamma, while the suite
+    // needs the stored byte values unchanged.
+    if (is_hdr) copy(stbi_loadf_from_memory(memory, length, &image.width, &image.height, &channels, 3));
+    else copy(stbi_load_from_memory(memory, length, &image.width, &image.height, &channels, 3));
     return image;
+}
+
+// Reads an image file (see decode_image); only regular files are read, so a scene cannot name a
+// device or a pipe and block or exhaust the reader.
+inline Image read_image(const std::filesystem::path& path) {
+    std::error_code error;
+    if (!std::filesystem::is_regular_file(path, error)) throw io::LoadError(path, "", "no such image file");
+    std::ifstream stream(path, std::ios::binary);
+    if (!stream) throw io::LoadError(path, "", "cannot open the image file");
+    const std::string bytes((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+    if (stream.bad()) throw io::LoadError(path, "", "cannot read the image file");
+    return decode_image(bytes, path);
 }
 
 }  // namespace prism

@@ -164,6 +164,17 @@ public:
         return value;
     }
 
+    // An integer the renderer must not be asked beyond prism's limit `maximum` (limits.hpp);
+    // `remedy`, when given, says how a user may raise it.
+    long long integer_within_limit(const Element& element, long long minimum, long long maximum,
+                                   const std::string& remedy = {}) const {
+        const long long value = integer_at_least(element, minimum);
+        if (value > maximum)
+            fail(element, std::to_string(value) + " is over prism's limit of " + std::to_string(maximum) +
+                              (remedy.empty() ? std::string() : " (" + remedy + ")"));
+        return value;
+    }
+
     long long integer_attribute(const Element& element, std::string_view name, long long fallback) const {
         const std::string* value = element.attribute(name);
         if (value == nullptr) return fallback;

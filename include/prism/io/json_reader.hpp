@@ -6,6 +6,7 @@
 #pragma once
 
 #include <prism/io/element.hpp>
+#include <prism/io/limits.hpp>
 #include <prism/io/load_error.hpp>
 
 #include <nlohmann/json.hpp>
@@ -13,6 +14,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -37,6 +39,7 @@ public:
     bool binary(Json::binary_t&) { return fail("binary values have no meaning in a scene file"); }
 
     bool start_object(std::size_t) {
+        if (too_deep()) return false;
         std::string name;
         if (!stack_.empty()) {
             const Frame& top = stack_.back();
@@ -69,6 +72,7 @@ public:
     }
 
     bool start_array(std::size_t) {
+        if (too_deep()) return false;
         if (stack_.empty()) return fail("the file must hold a JSON object, not an array");
         const Frame& top = stack_.back();
         if (top.is_array) return fail("an array inside an array has no meaning in a scene file");
@@ -140,6 +144,19 @@ private:
         return true;
     }
 
+    // The tree is labelled and destroyed by recursion, so its depth is bounded here, where the
+    // parser (which keeps its own stack on the heap) opens each level. stack_ holds the unnamed
+    // document as well, so it may be one deeper than the elements.
+    bool too_deep() {
+        if (stack_.size() <= std::size_t(max_element_depth)) return false;
+        fail("elements nest more than " + std::to_string(max_element_depth) + " deep");
+        // The whole path would repeat 64 labels: its two ends say where.
+        const std::size_t first = error_path_.find('/'), last = error_path_.rfind('/');
+        if (first != std::string::npos && first != last)
+            error_path_ = error_path_.substr(0, first) + "/.../" + error_path_.substr(last + 1);
+        return true;
+    }
+
     bool fail(std::string message) {
         error_ = std::move(message);
         error_path_ = current_path();
@@ -166,11 +183,13 @@ private:
 
 }  // namespace detail::json
 
-inline Element read_json(const std::filesystem::path& path) {
-    const std::string contents = read_text_file(path);
+// Parses a scene file's contents already in memory; `path` names the file in messages.
+inline Element parse_json(std::string_view contents, const std::filesystem::path& path) {
     detail::json::TreeBuilder builder;
     if (!nlohmann::json::sax_parse(contents, &builder)) throw LoadError(path, builder.error_path(), builder.error());
     return builder.take_root(path);
 }
+
+inline Element read_json(const std::filesystem::path& path) { return parse_json(read_text_file(path), path); }
 
 }  // namespace prism::io

@@ -562,11 +562,11 @@ inline std::string read_file(const std::filesystem::path& path) {
 
 }  // namespace detail::ply
 
-inline PlyMesh read_ply(const std::filesystem::path& path) {
+// Parses a PLY file's bytes already in memory; `path` names the file in messages.
+inline PlyMesh parse_ply(std::string_view bytes, const std::filesystem::path& path) {
     using namespace detail::ply;
-    const std::string bytes = read_file(path);
     const Header header = parse_header(path, bytes);
-    const std::string_view data = std::string_view(bytes).substr(header.data_offset);
+    const std::string_view data = bytes.substr(header.data_offset);
     PlyMesh mesh;
     constexpr bool little_endian_machine = std::endian::native == std::endian::little;
     if (header.format == Format::ascii) {
@@ -581,5 +581,7 @@ inline PlyMesh read_ply(const std::filesystem::path& path) {
     }
     return mesh;
 }
+
+inline PlyMesh read_ply(const std::filesystem::path& path) { return parse_ply(detail::ply::read_file(path), path); }
 
 }  // namespace prism::io

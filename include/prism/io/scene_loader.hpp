@@ -25,6 +25,7 @@
 #include <prism/io/binary_data.hpp>
 #include <prism/io/element.hpp>
 #include <prism/io/element_reader.hpp>
+#include <prism/io/limits.hpp>
 #include <prism/io/load_error.hpp>
 #include <prism/io/ply.hpp>
 #include <prism/io/texture_loader.hpp>
@@ -61,6 +62,8 @@ struct LoadOptions {
     // when the course's files had no material types; cornellbox_glossy's untyped spheres with
     // a Roughness are glossy mirrors). No file says which year's rules it follows.
     bool untyped_mirrors_reflect = false;
+    // What a file may ask for (limits.hpp); prism --max-recursion-depth raises the depth.
+    ResourceLimits limits;
 };
 
 namespace detail::scene_loader {
@@ -88,7 +91,9 @@ public:
             if (name == "BackgroundColor") scene_.background_color = vector3(child);
             else if (name == "ShadowRayEpsilon") scene_.shadow_ray_epsilon = non_negative(child);
             else if (name == "IntersectionTestEpsilon") scene_.intersection_test_epsilon = non_negative(child);
-            else if (name == "MaxRecursionDepth") scene_.max_recursion_depth = int(integer_at_least(child, 0));
+            else if (name == "MaxRecursionDepth") scene_.max_recursion_depth = int(integer_within_limit(
+                child, 0, std::min(options_.limits.max_recursion_depth, stack_safe_recursion_depth),
+                "--max-recursion-depth raises it up to " + std::to_string(stack_safe_recursion_depth)));
             else if (name == "Camera") read_camera(child);  // 2017: cameras directly under <Scene>
             else if (name == "Cameras") read_cameras(child);
             else if (name == "Lights") read_lights(child);
@@ -291,6 +296,10 @@ private:
             size[1] > std::numeric_limits<int>::max())
             fail(resolution, "the image resolution must be positive, not " + std::to_string(size[0]) + " x " +
                                  std::to_string(size[1]));
+        if (size[0] > max_image_side || size[1] > max_image_side || size[0] * size[1] > max_image_pixels)
+            fail(resolution, std::to_string(size[0]) + " x " + std::to_string(size[1]) + " is over prism's limits, " +
+                                 std::to_string(max_image_side) + " pixels a side and " +
+                                 std::to_string(max_image_pixels) + " in all");
         camera.width = int(size[0]);
         camera.height = int(size[1]);
 
@@ -348,7 +357,7 @@ private:
 
         camera.image_name = text_of(required(element, "ImageName"));
         if (camera.image_name.empty()) fail(required(element, "ImageName"), "the image name is empty");
-        if (const Element* e = element.child("NumSamples")) camera.num_samples = int(integer_at_least(*e, 1));
+        if (const Element* e = element.child("NumSamples")) camera.num_samples = int(integer_within_limit(*e, 1, max_samples_per_pixel));
         if (const Element* e = element.child("ApertureSize")) camera.aperture_size = non_negative(*e);
         if (const Element* e = element.child("FocusDistance")) camera.focus_distance = non_negative(*e);
         // <Filter>box|gaussian</Filter>: prism's own extension, not a course element; box (equal
@@ -686,6 +695,7 @@ private:
             }
         }
         if (!has_faces) fail(element, "missing <Faces>");
+        count_triangles(element, mesh.triangles.size());
         finish_mesh(mesh);
         mesh.textures = textures_.textures_of(element);
         mesh.motion = motion_of(element);
@@ -706,11 +716,24 @@ private:
         if (corners.size() != 3) fail(indices, "expected 3 vertex indices, found " + std::to_string(corners.size()));
         MeshBuilder builder{mesh};
         add_indexed_faces(builder, indices, corners, 0, 0);
+        count_triangles(element, 1);
         finish_mesh(mesh);
         mesh.textures = textures_.textures_of(element);
         mesh.motion = motion_of(element);
         note_unsupported_children(element, {"Material", "Transformations", "Indices", "Textures", "Texture", "MotionBlur"});
         scene_.meshes.push_back(std::move(mesh));
+    }
+
+    // The scene's triangles so far against the memory rendering them will take (limits.hpp).
+    void count_triangles(const Element& element, std::size_t added) {
+        triangles_ += added;
+        const std::uint64_t needed = triangles_ * render_bytes_per_triangle;
+        if (options_.limits.memory_bytes != 0 && needed > options_.limits.memory_bytes) {
+            const auto mib = [](std::uint64_t bytes) { return std::to_string(bytes >> 20) + " MiB"; };
+            fail(element, "the scene's meshes reach " + std::to_string(triangles_) + " triangles here, about " +
+                              mib(needed) + " to render, more than the " + mib(options_.limits.memory_bytes) +
+                              " of memory prism may use");
+        }
     }
 
     static void finish_mesh(scene::Mesh& mesh) {
@@ -772,35 +795,40 @@ private:
             if (!instance_indices.emplace(id_of(*elements[i]), i).second) ambiguous_instance_ids.insert(id_of(*elements[i]));
 
         // baseMeshId names a Mesh; should it name another MeshInstance, the instance resolves to
-        // that instance's mesh, after that instance's transform.
-        const auto resolve = [&](auto& self, std::size_t i) -> void {
-            if (state[i] == State::done) return;
+        // that instance's mesh, after that instance's transform. base_instance finds which.
+        const auto base_instance = [&](std::size_t i) -> std::optional<std::size_t> {
             const Element& element = *elements[i];
-            if (state[i] == State::resolving) fail(element, "the instances' baseMeshId references form a cycle");
-            state[i] = State::resolving;
+            const std::string base_id(trim(required_attribute(element, "baseMeshId")));
+            if (mesh_indices_.count(base_id) != 0) {
+                if (ambiguous_mesh_ids_.count(base_id) != 0)
+                    fail(element, "baseMeshId " + in_quotes(base_id) + " is ambiguous: several meshes have this id");
+                return std::nullopt;
+            }
+            const auto other = instance_indices.find(base_id);
+            if (other == instance_indices.end())
+                fail(element, "unknown baseMeshId " + in_quotes(base_id) + ": no <Mesh> has this id");
+            if (ambiguous_instance_ids.count(base_id) != 0)
+                fail(element, "baseMeshId " + in_quotes(base_id) + " is ambiguous: several instances have this id");
+            return other->second;
+        };
+        // Resolves instance i, whose base (if an instance) is done.
+        const auto resolve = [&](std::size_t i) {
+            const Element& element = *elements[i];
             scene::MeshInstance& instance = instances[i];
             instance.id = id_of(element);
-            const std::string base_id(trim(required_attribute(element, "baseMeshId")));
             glm::dmat4 base_transform(1.0);
             std::size_t base_material = 0;
             std::vector<std::size_t> base_textures;
-            if (const auto mesh = mesh_indices_.find(base_id); mesh != mesh_indices_.end()) {
-                if (ambiguous_mesh_ids_.count(base_id) != 0)
-                    fail(element, "baseMeshId " + in_quotes(base_id) + " is ambiguous: several meshes have this id");
-                instance.base_mesh = mesh->second;
-                base_transform = scene_.meshes[mesh->second].transform;
-                base_material = scene_.meshes[mesh->second].material;
-                base_textures = scene_.meshes[mesh->second].textures;
-            } else if (const auto other = instance_indices.find(base_id); other != instance_indices.end()) {
-                if (ambiguous_instance_ids.count(base_id) != 0)
-                    fail(element, "baseMeshId " + in_quotes(base_id) + " is ambiguous: several instances have this id");
-                self(self, other->second);
-                instance.base_mesh = instances[other->second].base_mesh;
-                base_transform = instances[other->second].transform;
-                base_material = instances[other->second].material;
-                base_textures = instances[other->second].textures;
+            if (const std::optional<std::size_t> other = base_instance(i)) {
+                instance.base_mesh = instances[*other].base_mesh;
+                base_transform = instances[*other].transform;
+                base_material = instances[*other].material;
+                base_textures = instances[*other].textures;
             } else {
-                fail(element, "unknown baseMeshId " + in_quotes(base_id) + ": no <Mesh> has this id");
+                instance.base_mesh = mesh_indices_.at(std::string(trim(*element.attribute("baseMeshId"))));
+                base_transform = scene_.meshes[instance.base_mesh].transform;
+                base_material = scene_.meshes[instance.base_mesh].material;
+                base_textures = scene_.meshes[instance.base_mesh].textures;
             }
             const glm::dmat4 own = transformation_of(element);
             instance.transform = boolean_attribute(element, "resetTransform", false) ? own : own * base_transform;
@@ -815,7 +843,17 @@ private:
             note_unsupported_children(element, {"Material", "Transformations", "Textures", "Texture", "MotionBlur"});
             state[i] = State::done;
         };
-        for (std::size_t i = 0; i < elements.size(); ++i) resolve(resolve, i);
+        // A chain of instances is followed down to its mesh on a list, then resolved from the mesh
+        // up: a loop, not recursion, so no chain in a file can overflow the stack.
+        for (std::size_t i = 0; i < elements.size(); ++i) {
+            std::vector<std::size_t> chain;
+            for (std::optional<std::size_t> k = i; k && state[*k] != State::done; k = base_instance(*k)) {
+                if (state[*k] == State::resolving) fail(*elements[*k], "the instances' baseMeshId references form a cycle");
+                state[*k] = State::resolving;
+                chain.push_back(*k);
+            }
+            for (auto k = chain.rbegin(); k != chain.rend(); ++k) resolve(*k);
+        }
         for (scene::MeshInstance& instance : instances) scene_.mesh_instances.push_back(std::move(instance));
     }
 
@@ -828,6 +866,7 @@ private:
     std::map<std::string, std::size_t> material_indices_;
     std::map<std::string, std::size_t> mesh_indices_;     // ids of Mesh elements only
     std::set<std::string> ambiguous_mesh_ids_;
+    std::uint64_t triangles_ = 0;
 };
 
 }  // namespace detail::scene_loader

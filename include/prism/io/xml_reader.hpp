@@ -4,6 +4,7 @@
 #pragma once
 
 #include <prism/io/element.hpp>
+#include <prism/io/limits.hpp>
 #include <prism/io/load_error.hpp>
 
 #include <pugixml.hpp>
@@ -108,15 +109,20 @@ inline std::string open_elements_at(std::string_view text, std::size_t offset) {
     return path;
 }
 
-inline Element convert(const pugi::xml_node& node, const LineTable& lines) {
+// Recursive, so the depth is checked first: the file must not choose how deep the stack goes.
+inline Element convert(const pugi::xml_node& node, const LineTable& lines, const std::filesystem::path& path,
+                       int depth = 1) {
     Element element;
     element.name = node.name();
     element.line = lines.line(node.offset_debug());
+    if (depth > max_element_depth)
+        throw LoadError(path, element_label(element.name, nullptr) + " (line " + std::to_string(element.line) + ")",
+                        "elements nest more than " + std::to_string(max_element_depth) + " deep");
     for (const pugi::xml_attribute& attribute : node.attributes())
         element.attributes.emplace_back(attribute.name(), attribute.value());
     for (const pugi::xml_node& child : node.children()) {
         if (child.type() == pugi::node_element) {
-            element.children.push_back(convert(child, lines));
+            element.children.push_back(convert(child, lines, path, depth + 1));
         } else if (child.type() == pugi::node_pcdata || child.type() == pugi::node_cdata) {
             // Text split by a comment (`1 2 <!-- -->3`) must not glue two numbers together.
             if (!element.text.empty()) element.text += ' ';
@@ -128,8 +134,8 @@ inline Element convert(const pugi::xml_node& node, const LineTable& lines) {
 
 }  // namespace detail::xml
 
-inline Element read_xml(const std::filesystem::path& path) {
-    const std::string contents = read_text_file(path);
+// Parses a scene file's contents already in memory; `path` names the file in messages.
+inline Element parse_xml(std::string_view contents, const std::filesystem::path& path) {
     const detail::xml::LineTable lines(contents);
     pugi::xml_document document;
     const pugi::xml_parse_result result = document.load_buffer(contents.data(), contents.size());
@@ -141,9 +147,11 @@ inline Element read_xml(const std::filesystem::path& path) {
     }
     const pugi::xml_node root = document.document_element();
     if (!root) throw LoadError(path, "", "the file holds no XML element");
-    Element tree = detail::xml::convert(root, lines);
+    Element tree = detail::xml::convert(root, lines, path);
     assign_paths(tree);
     return tree;
 }
+
+inline Element read_xml(const std::filesystem::path& path) { return parse_xml(read_text_file(path), path); }
 
 }  // namespace prism::io

@@ -48,7 +48,7 @@ struct RenderOptions {
     std::optional<Precision> precision;   // empty: chosen from the scene
     double resolution_scale = 1.0;        // < 1 renders a reduced image (suite, quick checks)
     int max_samples = 0;                  // > 0 caps every camera's NumSamples (quick checks)
-    bool cull_backfaces = false;          // primary rays skip triangles facing away
+    BackfaceCulling backface_culling = BackfaceCulling::flat_triangles;  // what camera rays skip from behind
     std::optional<RayOffset> ray_offset;  // empty: chosen from the scene (choose_ray_offset)
     std::uint64_t seed = 0;               // the pixels' random streams (multisampling, lights)
 };
@@ -173,7 +173,7 @@ std::vector<CameraImage> render_with(const scene::Scene& scene, const RenderOpti
                                      const std::function<void(std::size_t camera, int pixels)>& on_tile) {
     using Clock = std::chrono::steady_clock;
     const auto build_start = Clock::now();
-    const Renderer<C> renderer(scene, RendererSettings{options.cull_backfaces, *options.ray_offset, options.seed});
+    const Renderer<C> renderer(scene, RendererSettings{options.backface_culling, *options.ray_offset, options.seed});
     const double build_seconds = std::chrono::duration<double>(Clock::now() - build_start).count();
     log << "built " << renderer.geometry().instance_count() << " instances, " << renderer.geometry().triangle_count()
         << " triangles in " << build_seconds << " s\n";

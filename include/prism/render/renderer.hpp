@@ -25,7 +25,7 @@
 namespace prism {
 
 struct RendererSettings {
-    bool cull_backfaces = false;  // primary rays skip triangles facing away
+    BackfaceCulling backface_culling = BackfaceCulling::flat_triangles;  // what camera rays skip from behind
     RayOffset ray_offset = RayOffset::scene_epsilon;
     std::uint64_t seed = 0;       // selects the pixels' random streams
 };
@@ -51,7 +51,7 @@ public:
           integrator_(geometry_, lights_, materials_, textures_, environment_, Vec3<Real>(scene.ambient_light),
                       Vec3<Real>(scene.background_color),
                       IntegratorSettings{scene.max_recursion_depth, scene.shadow_ray_epsilon, settings.ray_offset,
-                                         settings.cull_backfaces}) {}
+                                         settings.backface_culling}) {}
 
     // A renderer holds references into itself (the integrator into geometry and lights).
     Renderer(const Renderer&) = delete;

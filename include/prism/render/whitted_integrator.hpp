@@ -7,6 +7,7 @@
 // Roughness perturbing each reflected and refracted direction once per camera sample.
 #pragma once
 
+#include <prism/geometry/backface_culling.hpp>
 #include <prism/geometry/hit.hpp>
 #include <prism/material/fresnel.hpp>
 #include <prism/material/material.hpp>
@@ -33,7 +34,8 @@ struct IntegratorSettings {
     int max_recursion_depth = 0;
     double shadow_ray_epsilon = 1e-3;  // RayOffset::scene_epsilon's offset
     RayOffset ray_offset = RayOffset::scene_epsilon;
-    bool cull_backfaces = false;  // for primary rays; secondary rays must see back faces
+    // What camera rays skip when they meet it from behind; secondary rays see every back face.
+    BackfaceCulling backface_culling = BackfaceCulling::flat_triangles;
 };
 
 // A surface's textures as the integrator uses them; `NoTextures` is the policy of renderers
@@ -98,9 +100,7 @@ private:
     // simplest variant).
     Vec3<Real> trace(Ray<Real> ray, int depth, CameraPath& path, Real travelled) const {
         Hit<Real> hit;
-        const bool found = (depth == 0 && settings_.cull_backfaces) ? geometry_.template intersect<true>(ray, hit)
-                                                                    : geometry_.template intersect<false>(ray, hit);
-        if (!found) return escaped(ray.direction, depth, path.pixel_uv);
+        if (!intersect(ray, depth, hit)) return escaped(ray.direction, depth, path.pixel_uv);
 
         SurfacePoint<Real> point = geometry_.surface(ray, hit);
         Material<Real> material = materials_[point.material];
@@ -154,6 +154,19 @@ private:
             color *= transmittance;
         }
         return color;
+    }
+
+    // The closest hit, skipping back faces as settings_.backface_culling says for camera rays.
+    bool intersect(Ray<Real>& ray, int depth, Hit<Real>& hit) const {
+        if (depth == 0) {
+            switch (settings_.backface_culling) {
+                case BackfaceCulling::none: break;
+                case BackfaceCulling::flat_triangles:
+                    return geometry_.template intersect<BackfaceCulling::flat_triangles>(ray, hit);
+                case BackfaceCulling::all: return geometry_.template intersect<BackfaceCulling::all>(ray, hit);
+            }
+        }
+        return geometry_.template intersect<BackfaceCulling::none>(ray, hit);
     }
 
     // A ray that meets nothing: primary rays show the background (texture, environment or

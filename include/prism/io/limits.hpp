@@ -1,0 +1,57 @@
+// The limits that keep a hostile or mistaken scene file from exhausting memory or the native stack.
+// Each is chosen from what the course's scenes use (../shared/ceng795, hw1-hw7: MaxRecursionDepth
+// at most 6, NumSamples at most 2500, images at most 1920 x 1080 rendered and 2000 x 3008 read),
+// with an order of magnitude of headroom. A file past a limit is refused with a LoadError naming
+// the element, before anything is allocated for it.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include <unistd.h>
+
+namespace prism::io {
+
+// Nested elements deeper than this are refused: the course's files nest 4 deep (Scene, Objects,
+// Mesh, Faces), and the element tree is built, labelled and destroyed by recursion, so its depth
+// must not be the input's to choose.
+inline constexpr int max_element_depth = 64;
+
+// The Whitted integrator recurses once per reflection or refraction on the native stack (of a TBB
+// worker: 4 MiB on 64-bit). stack_safe_recursion_depth is the most --max-recursion-depth may allow.
+// Measured on hw2's mirror_room (two facing mirrors, so rays do bounce that deep), Release build,
+// --threads 1 under `ulimit -s`: 512 levels run in 1 MiB of stack, float and double alike; 1024
+// levels need more than 1 MiB and less than 2.
+inline constexpr int stack_safe_recursion_depth = 512;
+
+// Rendered images: either side at most 32768 pixels and at most 2^27 pixels in all (134 million;
+// its film of float RGB takes 1.5 GiB). Read images (textures, environment maps) likewise.
+inline constexpr std::int64_t max_image_side = 32768;
+inline constexpr std::int64_t max_image_pixels = std::int64_t(1) << 27;
+
+// Samples per pixel: the course's most is 2500.
+inline constexpr std::int64_t max_samples_per_pixel = 65536;
+
+// Memory a triangle costs from loading to rendering: the peak resident size of `prism` on a flat
+// grid mesh from a binary PLY (2 and 8 million triangles, half as many vertices, 16 x 16 pixels)
+// grew by 160 bytes a triangle with --precision float and 268 with double; rounded up.
+inline constexpr std::uint64_t render_bytes_per_triangle = 300;
+
+// The machine's physical memory (0 when the system will not say).
+inline std::uint64_t physical_memory_bytes() {
+    const long pages = ::sysconf(_SC_PHYS_PAGES), page_size = ::sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && page_size > 0 ? std::uint64_t(pages) * std::uint64_t(page_size) : 0;
+}
+
+// The limits that may differ from one run to the next; the others are fixed.
+struct ResourceLimits {
+    // The course's scenes ask for at most 6; 64 leaves ten times that. prism
+    // --max-recursion-depth sets it, up to stack_safe_recursion_depth. Each Whitted dielectric
+    // bounce traces two rays, so time, not stack, is what a deep glass scene runs out of first.
+    int max_recursion_depth = 64;
+    // A scene whose meshes would need more than this to render (render_bytes_per_triangle each)
+    // is refused at the mesh that passes it, instead of failing later in an allocation.
+    std::uint64_t memory_bytes = physical_memory_bytes();
+};
+
+}  // namespace prism::io

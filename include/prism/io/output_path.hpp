@@ -1,0 +1,53 @@
+// Where a scene's ImageName may be written: inside the output folder the user chose, never outside
+// it. A downloaded scene file must not be able to name `/home/user/photo.png` or `../../x.png` and
+// overwrite a file the user can write, so absolute names, names that climb out with `..`, and names
+// that leave through a symbolic link already in the folder are refused. No option lifts this: a
+// user who wants images elsewhere says so with --output-dir, not the scene file.
+#pragma once
+
+#include <prism/io/load_error.hpp>
+
+#include <filesystem>
+#include <string>
+#include <system_error>
+
+namespace prism::io {
+
+// The path `image_name` (as written in the scene file `scene_file`, at `element`) resolves to under
+// `output_dir`; throws a LoadError naming the file and the element when it would leave the folder.
+inline std::filesystem::path confined_output_path(const std::filesystem::path& output_dir,
+                                                  const std::filesystem::path& image_name,
+                                                  const std::filesystem::path& scene_file, const std::string& element) {
+    const auto refuse = [&](const std::string& why) {
+        return LoadError(scene_file, element, "\"" + image_name.string() + "\" " + why +
+                                                  ": images are written inside --output-dir only");
+    };
+    if (image_name.has_root_name() || image_name.has_root_directory()) throw refuse("is an absolute path");
+    const std::filesystem::path normal = image_name.lexically_normal();
+    if (normal.empty() || !normal.has_filename() || normal == ".") throw refuse("names no file");
+    if (*normal.begin() == "..") throw refuse("leaves the output folder");
+
+    // A symbolic link inside the folder (`out/link -> /etc`) leaves it too: every link on the way
+    // must resolve, and resolve inside the folder. A dangling link is refused: the writer would
+    // follow it wherever it comes to point.
+    std::error_code error;
+    const std::filesystem::path folder = std::filesystem::weakly_canonical(output_dir, error);
+    if (error) throw LoadError(output_dir, "", "cannot resolve the output folder: " + error.message());
+    const auto inside_folder = [&](const std::filesystem::path& real) {
+        const std::filesystem::path relative = real.lexically_relative(folder);
+        return !relative.empty() && *relative.begin() != "..";
+    };
+    std::filesystem::path prefix = output_dir;
+    for (const std::filesystem::path& component : normal) {
+        prefix /= component;
+        if (!std::filesystem::is_symlink(std::filesystem::symlink_status(prefix, error))) continue;
+        const std::filesystem::path real = std::filesystem::canonical(prefix, error);
+        if (error) throw refuse("passes through a link that points nowhere");
+        if (!inside_folder(real)) throw refuse("leaves the output folder through a link");
+    }
+    if (!inside_folder(std::filesystem::weakly_canonical(output_dir / normal, error)) || error)
+        throw refuse("leaves the output folder");
+    return output_dir / normal;
+}
+
+}  // namespace prism::io

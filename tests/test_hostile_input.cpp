@@ -1,0 +1,227 @@
+// Hostile input (issue 12): the limits a scene file may not pass, element trees and instance chains
+// no file can make overflow the stack, outputs confined to their folder, and every input the
+// fuzzers found (tests/data/fuzz/TARGET/) replayed through the reader it broke.
+#include "temporary_folder.hpp"
+
+#include <prism/image/image_io.hpp>
+#include <prism/io/json_reader.hpp>
+#include <prism/io/limits.hpp>
+#include <prism/io/load_error.hpp>
+#include <prism/io/output_path.hpp>
+#include <prism/io/ply.hpp>
+#include <prism/io/scene_loader.hpp>
+#include <prism/io/xml_reader.hpp>
+
+#include <doctest/doctest.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#ifndef PRISM_SOURCE_DIR
+#define PRISM_SOURCE_DIR "."
+#endif
+
+namespace {
+
+using prism::io::LoadError;
+
+// tests/data/good.xml with `extra` inserted after <Scene> and `camera_extra` after its ImageName.
+std::string scene_text(const std::string& extra, const std::string& camera_extra = {}) {
+    std::ifstream stream(std::filesystem::path(PRISM_SOURCE_DIR) / "tests/data/good.xml");
+    std::string text((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+    REQUIRE(!text.empty());
+    text.insert(text.find("<Scene>") + 7, extra);
+    const std::string image_name = "<ImageName>out.png</ImageName>";
+    text.insert(text.find(image_name) + image_name.size(), camera_extra);
+    return text;
+}
+
+prism::scene::Scene load_text(const std::string& text, const prism::io::LoadOptions& options = {}) {
+    return prism::io::interpret_scene(prism::io::parse_xml(text, "scene.xml"), "scene.xml", options);
+}
+
+// The message of the LoadError `load` throws, or "" when it throws none.
+std::string refusal(const std::function<void()>& load) {
+    try {
+        load();
+    } catch (const LoadError& error) {
+        return error.what();
+    }
+    return "";
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+}  // namespace
+
+TEST_CASE("MaxRecursionDepth: up to 64 by default, up to the option's value, never past the stack-safe depth") {
+    const auto depth = [](int value) { return "<MaxRecursionDepth>" + std::to_string(value) + "</MaxRecursionDepth>"; };
+    CHECK(load_text(scene_text(depth(64))).max_recursion_depth == 64);
+    const std::string over = refusal([&] { load_text(scene_text(depth(65))); });
+    CHECK(contains(over, "<MaxRecursionDepth>"));
+    CHECK(contains(over, "limit of 64"));
+
+    prism::io::LoadOptions raised;
+    raised.limits.max_recursion_depth = 300;
+    CHECK(load_text(scene_text(depth(300)), raised).max_recursion_depth == 300);
+    CHECK(contains(refusal([&] { load_text(scene_text(depth(301)), raised); }), "limit of 300"));
+
+    // An option past the stack-safe depth (only a program can set one) still stops there.
+    raised.limits.max_recursion_depth = 1 << 30;
+    const int safe = prism::io::stack_safe_recursion_depth;
+    CHECK(load_text(scene_text(depth(safe)), raised).max_recursion_depth == safe);
+    CHECK(contains(refusal([&] { load_text(scene_text(depth(safe + 1)), raised); }), "limit of " + std::to_string(safe)));
+}
+
+TEST_CASE("ImageResolution and NumSamples past prism's limits are refused, naming the element") {
+    const auto resolution = [](const std::string& size) {
+        std::string text = scene_text("");
+        const std::string written = "<ImageResolution>16 16</ImageResolution>";
+        return text.replace(text.find(written), written.size(), "<ImageResolution>" + size + "</ImageResolution>");
+    };
+    const std::int64_t side = prism::io::max_image_side;
+    CHECK(load_text(resolution(std::to_string(side) + " 16")).cameras.at(0).width == side);
+    CHECK(contains(refusal([&] { load_text(resolution(std::to_string(side + 1) + " 16")); }), "<ImageResolution>"));
+    CHECK(contains(refusal([&] { load_text(resolution("200000 200000")); }), "<ImageResolution>"));
+    // Each side within the limit, the product not.
+    CHECK(contains(refusal([&] { load_text(resolution("12000 12000")); }), "over prism's limits"));
+
+    const auto samples = [](std::int64_t count) { return "<NumSamples>" + std::to_string(count) + "</NumSamples>"; };
+    CHECK(load_text(scene_text("", samples(prism::io::max_samples_per_pixel))).cameras.at(0).num_samples ==
+          prism::io::max_samples_per_pixel);
+    const std::string over = refusal([&] { load_text(scene_text("", samples(2000000000))); });
+    CHECK(contains(over, "<NumSamples>"));
+    CHECK(contains(over, "limit of " + std::to_string(prism::io::max_samples_per_pixel)));
+}
+
+TEST_CASE("meshes that would need more memory to render than the limit are refused at the mesh") {
+    prism::io::LoadOptions options;
+    options.limits.memory_bytes = prism::io::render_bytes_per_triangle;  // one triangle's worth
+    CHECK(load_text(scene_text(""), options).meshes.size() == 1);
+    std::string two = scene_text("");
+    const std::string mesh = "<Mesh id=\"1\"><Material>1</Material><Faces>1 2 3</Faces></Mesh>";
+    two.insert(two.find(mesh) + mesh.size(), "<Mesh id=\"2\"><Material>1</Material><Faces>3 2 1</Faces></Mesh>");
+    const std::string message = refusal([&] { load_text(two, options); });
+    CHECK(contains(message, "<Mesh id=\"2\">"));
+    CHECK(contains(message, "2 triangles"));
+    CHECK(prism::io::physical_memory_bytes() > 0);
+}
+
+TEST_CASE("200,000 nested elements are refused in XML and JSON, without recursion that deep") {
+    const int depth = 200000;
+    std::string nested;
+    for (int i = 0; i < depth; ++i) nested += "<Group>";
+    for (int i = 0; i < depth; ++i) nested += "</Group>";
+    const std::string xml = refusal([&] { load_text(scene_text(nested)); });
+    CHECK(contains(xml, "<Group>"));
+    CHECK(contains(xml, "nest more than " + std::to_string(prism::io::max_element_depth)));
+
+    std::string json = "{\"Scene\": ";
+    for (int i = 0; i < depth; ++i) json += "{\"Group\": ";
+    json += "\"x\"" + std::string(std::size_t(depth) + 1, '}');
+    const std::string message = refusal([&] { prism::io::parse_json(json, "scene.json"); });
+    CHECK(contains(message, "<Group>/.../<Group>"));
+    CHECK(contains(message, "nest more than " + std::to_string(prism::io::max_element_depth)));
+
+    // The deepest tree allowed is read.
+    std::string deepest = "<Scene>";
+    for (int i = 1; i < prism::io::max_element_depth; ++i) deepest += "<Group>";
+    for (int i = 1; i < prism::io::max_element_depth; ++i) deepest += "</Group>";
+    CHECK(prism::io::parse_xml(deepest + "</Scene>", "scene.xml").children.size() == 1);
+}
+
+TEST_CASE("a chain of 20,000 MeshInstances, each naming the next, resolves without recursion") {
+    // Written from the end of the chain back to the mesh: each instance's base comes after it.
+    const int count = 20000;
+    std::string instances;
+    for (int i = count; i >= 2; --i)
+        instances += "<MeshInstance id=\"" + std::to_string(i) + "\" baseMeshId=\"" + std::to_string(i > 2 ? i - 1 : 1) +
+                     "\"><Transformations>t1</Transformations></MeshInstance>";
+    std::string text = scene_text("<Transformations><Translation id=\"1\">1 0 0</Translation></Transformations>");
+    const std::string mesh = "<Mesh id=\"1\"><Material>1</Material><Faces>1 2 3</Faces></Mesh>";
+    text.insert(text.find(mesh) + mesh.size(), instances);
+    const prism::scene::Scene scene = load_text(text);
+    REQUIRE(scene.mesh_instances.size() == std::size_t(count - 1));
+    // The first written is the last of the chain: count - 1 translations by 1 along x.
+    CHECK(scene.mesh_instances.front().id == std::to_string(count));
+    CHECK(scene.mesh_instances.front().base_mesh == 0);
+    CHECK(scene.mesh_instances.front().transform[3][0] == doctest::Approx(count - 1));
+    CHECK(scene.mesh_instances.back().transform[3][0] == doctest::Approx(1));
+
+    std::string cycle = scene_text("");
+    cycle.insert(cycle.find(mesh) + mesh.size(),
+                 "<MeshInstance id=\"2\" baseMeshId=\"3\"/><MeshInstance id=\"3\" baseMeshId=\"4\"/>"
+                 "<MeshInstance id=\"4\" baseMeshId=\"2\"/>");
+    CHECK(contains(refusal([&] { load_text(cycle); }), "form a cycle"));
+}
+
+TEST_CASE("confined_output_path: image names stay inside the output folder") {
+    const prism_test::TemporaryFolder folder;
+    const std::filesystem::path out = folder.path() / "out";
+    std::filesystem::create_directories(out);
+    const auto place = [&](const std::string& name) {
+        return prism::io::confined_output_path(out, name, "scene.xml", "<Camera id=\"1\">/<ImageName>");
+    };
+    CHECK(place("image.png") == out / "image.png");
+    CHECK(place("renders/./image.png") == out / "renders/image.png");
+    CHECK(place("renders/../image.png") == out / "image.png");
+
+    for (const std::string name : {"/tmp/image.png", "../image.png", "renders/../../image.png", "..", "renders/.."}) {
+        CAPTURE(name);
+        const std::string message = refusal([&] { place(name); });
+        CHECK(contains(message, "scene.xml"));
+        CHECK(contains(message, "<ImageName>"));
+    }
+
+    // Links: one that stays inside is followed, one that leaves or points nowhere is refused.
+    std::filesystem::create_directories(out / "inside");
+    std::filesystem::create_directories(folder.path() / "outside");
+    std::filesystem::create_directory_symlink(out / "inside", out / "to_inside");
+    std::filesystem::create_directory_symlink(folder.path() / "outside", out / "to_outside");
+    std::filesystem::create_directory_symlink(folder.path() / "nowhere", out / "dangling");
+    CHECK(place("to_inside/image.png") == out / "to_inside/image.png");
+    CHECK(contains(refusal([&] { place("to_outside/image.png"); }), "through a link"));
+    CHECK(contains(refusal([&] { place("dangling/image.png"); }), "points nowhere"));
+}
+
+TEST_CASE("decode_image refuses an image past the size limits before decoding it") {
+    // A PNG header that claims 12000 x 12000 pixels (144 million, over 2^27) and holds none.
+    const std::string signature = "\x89PNG\r\n\x1a\n";
+    std::string header = std::string("\0\0\0\x0dIHDR", 8) + std::string("\0\0\x2e\xe0\0\0\x2e\xe0\x08\x02\0\0\0", 13);
+    header += std::string("\0\0\0\0", 4);  // CRC: stb does not check it
+    const std::string message = refusal([&] { prism::decode_image(signature + header, "huge.png"); });
+    CHECK(contains(message, "huge.png"));
+    CHECK(contains(message, "12000 x 12000"));
+    // The same header under a lower cap, as the image fuzzer sets it.
+    CHECK(contains(refusal([&] { prism::decode_image(signature + header, "huge.png", 1 << 16); }), "65536 in all"));
+}
+
+// Every input a fuzzer found, replayed through the reader it broke: each must now load or be refused
+// with a LoadError (a crash or a sanitizer report fails the test run).
+TEST_CASE("the fuzzers' findings stay fixed") {
+    const std::filesystem::path root = std::filesystem::path(PRISM_SOURCE_DIR) / "tests/data/fuzz";
+    REQUIRE(std::filesystem::is_directory(root));
+    int replayed = 0;
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(root)) {
+        if (!entry.is_regular_file()) continue;
+        std::ifstream stream(entry.path(), std::ios::binary);
+        const std::string bytes((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+        const std::string target = entry.path().parent_path().filename().string();
+        CAPTURE(entry.path().string());
+        try {
+            if (target == "xml") prism::io::interpret_scene(prism::io::parse_xml(bytes, entry.path()), entry.path());
+            else if (target == "json") prism::io::interpret_scene(prism::io::parse_json(bytes, entry.path()), entry.path());
+            else if (target == "ply") prism::io::parse_ply(bytes, entry.path());
+            else if (target == "image") prism::decode_image(bytes, entry.path());
+            else FAIL("unknown fuzz target folder " << target);
+        } catch (const LoadError&) {
+        }
+        ++replayed;
+    }
+    CHECK(replayed >= 2);
+}

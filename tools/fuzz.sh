@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# Fuzzes one of prism's readers with libFuzzer (clang, AddressSanitizer + UndefinedBehaviorSanitizer).
+#   bash tools/fuzz.sh TARGET SECONDS [extra libFuzzer flags]
+# TARGET: xml | json (scene loaders, to the scene description), ply (PLY reader), image (stb and
+# tinyexr behind decode_image). Builds what it needs in build-fuzz/, seeds the corpus
+# build-fuzz/corpus/TARGET from ../shared (and the repository's own scenes) the first time, runs
+# for SECONDS and prints libFuzzer's summary. Exit status: 0 when nothing was found, non-zero on a
+# finding (the input that triggered it is left in build-fuzz/findings/TARGET/).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+if [[ $# -lt 2 ]]; then
+  echo "usage: bash tools/fuzz.sh xml|json|ply|image SECONDS [libFuzzer flags]" >&2
+  exit 2
+fi
+target=$1 seconds=$2 max_len=65536
+shift 2
+case "$target" in
+  xml) binary=fuzz_scene_xml patterns=("*.xml") ;;
+  json) binary=fuzz_scene_json patterns=("*.json") ;;
+  ply) binary=fuzz_ply patterns=("*.ply") ;;
+  image) binary=fuzz_image max_len=16384 patterns=("*.png" "*.jpg" "*.jpeg" "*.hdr" "*.exr" "*.bmp" "*.tga" "*.ppm") ;;
+  *) echo "fuzz.sh: unknown target '$target' (xml, json, ply or image)" >&2; exit 2 ;;
+esac
+if ! [[ "$seconds" =~ ^[0-9]+$ ]] || [[ "$seconds" -lt 1 ]]; then
+  echo "fuzz.sh: SECONDS must be a positive whole number" >&2
+  exit 2
+fi
+
+if ! command -v clang++-14 >/dev/null || ! ls /usr/lib/llvm-14/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then
+  echo "fuzz.sh: installing clang-14 and libclang-rt-14-dev (libFuzzer)" >&2
+  apt-get install -y --no-install-recommends clang-14 libclang-rt-14-dev zlib1g-dev >&2
+fi
+
+build=build-fuzz
+if [[ ! -f $build/CMakeCache.txt ]]; then
+  cmake -S . -B $build -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14 \
+        -DPRISM_BUILD_FUZZERS=ON -DPRISM_BUILD_EXAMPLES=OFF -DPRISM_BUILD_TESTS=OFF >/dev/null
+fi
+cmake --build $build --target "$binary" -j "$(nproc)" >/dev/null
+
+# The seed corpus: the course's files of the target's kind, up to 64 KiB each (libFuzzer reads
+# only the first -max_len bytes of a larger one: 64 KiB, 16 KiB for images, whose decoding under
+# the sanitizers is slow), copied once; the corpus then grows by itself.
+corpus=$build/corpus/$target
+findings=$build/findings/$target
+mkdir -p "$corpus" "$findings"
+if [[ -z "$(ls -A "$corpus")" ]]; then
+  names=()
+  for pattern in "${patterns[@]}"; do names+=(-iname "$pattern" -o); done
+  unset 'names[${#names[@]}-1]'
+  for folder in ../shared scenes tests/data; do
+    [[ -d $folder ]] || continue
+    find "$folder" -type f \( "${names[@]}" \) -size -65k -print0 |
+      while IFS= read -r -d '' file; do cp "$file" "$corpus/$(sha1sum "$file" | cut -c1-40)"; done
+  done
+  [[ -d ../shared ]] || echo "fuzz.sh: ../shared is missing: the corpus starts from the repository's files only" >&2
+fi
+
+# -rss_limit_mb: a reader that needs more than 2 GiB for an input of at most 64 KiB is a finding.
+set +e
+"$build/fuzz/$binary" "$corpus" -max_total_time="$seconds" -max_len="$max_len" -rss_limit_mb=2048 -timeout=25 \
+  -artifact_prefix="$findings/" -print_final_stats=1 "$@" 2>"$build/fuzz-$target.log"
+status=$?
+set -e
+grep -E "^(#[0-9]+ +DONE|Done [0-9]+ runs|stat::number_of_executed_units|stat::peak_rss_mb|==[0-9]+==ERROR|SUMMARY|artifact_prefix|Test unit written)" \
+  "$build/fuzz-$target.log" || true
+if [[ $status -ne 0 ]]; then
+  echo "fuzz.sh: $target: a finding (libFuzzer exit $status); the full log is $build/fuzz-$target.log" >&2
+  tail -n 40 "$build/fuzz-$target.log" >&2
+  exit 1
+fi
+echo "fuzz.sh: $target: no finding"
