@@ -109,7 +109,7 @@ private:
     // Every child's entry distance; the mask says which children the ray enters within
     // [t_min, t_max]. A NaN distance (0 * inf, a ray in a slab's plane) constrains nothing,
     // as in the scalar intersect_box.
-    static simd::Mask<Real, N> enter(const WideBvhNode<Real, N>& node, const RaySlabs& ray, Real t_min, Real t_max,
+    [[gnu::always_inline]] static simd::Mask<Real, N> enter(const WideBvhNode<Real, N>& node, const RaySlabs& ray, Real t_min, Real t_max,
                                      Pack& entry) {
         const Pack scale = Pack::broadcast(far_scale);
         Pack t_enter = Pack::broadcast(t_min);
@@ -138,46 +138,64 @@ private:
         const RaySlabs slabs(ray);
         std::array<StackEntry, stack_size> stack;
         int size = 0;
-        stack[size++] = {0, 0, ray.t_min};
         bool found = false;
         alignas(64) Real distances[N];
-        while (size > 0) {
-            const StackEntry entry = stack[--size];
-            // A box entered beyond the closest hit so far cannot hold a closer one (compared
-            // with the widened t_max the box test itself uses).
-            if constexpr (!AnyHit) {
-                if (entry.distance > t_max * far_scale) continue;
+        std::uint32_t current = 0;  // the inner node to test next
+        for (;;) {
+            const WideBvhNode<Real, N>& node = nodes_[current];
+            Pack entry_distances;
+            std::uint32_t hits = enter(node, slabs, ray.t_min, t_max, entry_distances).bits();
+            bool descend = false;
+            if (hits != 0 && (hits & (hits - 1)) == 0) {
+                // One child entered, the common case deep in the tree: no stack, no sort.
+                const int i = std::countr_zero(hits);
+                if (node.count[i] == 0) {
+                    current = node.child[i];
+                    continue;
+                }
+                if (leaf(node.child[i], node.count[i], t_max)) {
+                    found = true;
+                    if constexpr (AnyHit) return true;
+                }
+            } else if (hits != 0) {
+                entry_distances.store(distances);
+                // Push the entered children farthest first, so the nearest is popped next: an
+                // insertion sort into the top of the stack, at most N - 1 moves per child.
+                const int base = size;
+                while (hits != 0) {
+                    const int i = std::countr_zero(hits);
+                    hits &= hits - 1;
+                    const StackEntry pushed{node.child[i], node.count[i], distances[i]};
+                    int slot = size++;
+                    if constexpr (!AnyHit) {
+                        while (slot > base && stack[slot - 1].distance < pushed.distance) {
+                            stack[slot] = stack[slot - 1];
+                            --slot;
+                        }
+                    }
+                    stack[slot] = pushed;
+                }
             }
-            if (entry.count != 0) {
+            // Pop until an inner node to descend into; leaves on the way are tested at once.
+            while (size > 0) {
+                const StackEntry entry = stack[--size];
+                // A box entered beyond the closest hit so far cannot hold a closer one (compared
+                // with the widened t_max the box test itself uses).
+                if constexpr (!AnyHit) {
+                    if (entry.distance > t_max * far_scale) continue;
+                }
+                if (entry.count == 0) {
+                    current = entry.child;
+                    descend = true;
+                    break;
+                }
                 if (leaf(entry.child, entry.count, t_max)) {
                     found = true;
                     if constexpr (AnyHit) return true;
                 }
-                continue;
             }
-            const WideBvhNode<Real, N>& node = nodes_[entry.child];
-            Pack entry_distances;
-            std::uint32_t hits = enter(node, slabs, ray.t_min, t_max, entry_distances).bits();
-            if (hits == 0) continue;
-            entry_distances.store(distances);
-            // Push the entered children farthest first, so the nearest is popped next: an
-            // insertion sort into the top of the stack, at most N - 1 moves per child.
-            const int base = size;
-            while (hits != 0) {
-                const int i = std::countr_zero(hits);
-                hits &= hits - 1;
-                StackEntry pushed{node.child[i], node.count[i], distances[i]};
-                int slot = size++;
-                if constexpr (!AnyHit) {
-                    while (slot > base && stack[slot - 1].distance < pushed.distance) {
-                        stack[slot] = stack[slot - 1];
-                        --slot;
-                    }
-                }
-                stack[slot] = pushed;
-            }
+            if (!descend) return found;
         }
-        return found;
     }
 
     std::uint32_t new_node() {

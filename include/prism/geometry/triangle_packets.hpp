@@ -129,7 +129,7 @@ private:
 
     // Watertight::intersect on every lane: the lanes hit in (t_min, t_max], with their t and
     // barycentrics stored. Same operations, same order, so the same bits as the scalar test.
-    static std::uint32_t test(const Packet& packet, const PackedRay& ray, Storage t_min, Storage t_max,
+    [[gnu::always_inline]] static std::uint32_t test(const Packet& packet, const PackedRay& ray, Storage t_min, Storage t_max,
                               Storage* t_out, Storage* b1_out, Storage* b2_out) {
         const auto relative = [&](int vertex, int axis) {
             return Pack::load(packet.vertices[vertex][axis]) - ray.origin[axis];
