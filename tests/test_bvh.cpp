@@ -371,7 +371,7 @@ void compare_policy_with_brute_force(const scene::Scene& world, const std::vecto
             report(i, "different primitive at a different t");
         }
     }
-    MESSAGE(typeid(Policy).name() << ": " << rays.size() << " rays: " << hits << " hits (mesh " << per_object[0] << ", instance " << per_object[1]
+    MESSAGE(std::string(typeid(Policy).name()) << ": " << rays.size() << " rays: " << hits << " hits (mesh " << per_object[0] << ", instance " << per_object[1]
                         << ", sphere " << per_object[2] << "), " << ties << " exact ties between triangles");
     // The ray set must exercise what it claims to: most rays hit, some miss, every object is hit.
     CHECK(hits > rays.size() / 2);
