@@ -72,6 +72,9 @@ public:
     // Leaf ranges padded to multiples of N (see the top of this file).
     const std::vector<std::uint32_t>& primitive_indices() const { return primitive_indices_; }
     Aabb<Real> bounds() const { return bounds_; }
+    std::size_t memory_bytes() const {
+        return nodes_.capacity() * sizeof(WideBvhNode<Real, N>) + primitive_indices_.capacity() * sizeof(std::uint32_t);
+    }
 
     template <class Leaf>
     void traverse_closest(const Ray<Real>& ray, Real& t_max, Leaf&& leaf) const {

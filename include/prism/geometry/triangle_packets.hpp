@@ -66,6 +66,10 @@ public:
         }
     }
 
+    std::size_t memory_bytes() const {
+        return packets_.capacity() * sizeof(Packet) + normals_.capacity() * sizeof(Vec3<Real>);
+    }
+
     // Closest hit among slots [first, first + count) (first a multiple of N); lowers t_limit.
     template <bool CullBackfaces>
     bool intersect(const PackedRay& ray, const Vec3<Real>& direction, std::uint32_t first, std::uint32_t count,
