@@ -2,8 +2,11 @@
 // Watertight, DoubleRefine) in float and double traces the same ray batches (primary, shadow,
 // diffuse) over two workloads: the largest hw1 course scene and the tiny-triangle dragon
 // (dragon_lowres subdivided to 766,144 triangles, made in process by prism/scene/stress.hpp);
-// Embree 3 traces them too when it is installed (PRISM_BENCH_WITH_EMBREE). Also: BVH build
-// times, and paired time ratios between variants that stand up to a shared, noisy machine.
+// Embree 3 traces them too when it is installed (PRISM_BENCH_WITH_EMBREE). The wide BVH
+// (WideBvh, 4 and 8 children) runs Watertight in float and double and DoubleRefine, and the
+// renderer's own choices run as default_float, default_double and default_double_refine. Also:
+// BVH build times, and paired time ratios between variants that stand up to a shared, noisy
+// machine.
 //
 // Every ray benchmark checks its answers: hit or miss (occluded or not, for shadow rays) per ray
 // against a double-precision Watertight reference computed once; robust variants that disagree
@@ -17,6 +20,7 @@
 #include <prism/geometry/scene_geometry.hpp>
 #include <prism/geometry/watertight.hpp>
 #include <prism/io/load.hpp>
+#include <prism/render/render_scene.hpp>
 #include <prism/scene/stress.hpp>
 
 #include <benchmark/benchmark.h>
@@ -109,9 +113,9 @@ struct Workload {
 
 using ReferenceGeometry = prism::SceneGeometry<double, prism::Bvh<prism::Watertight>>;
 
-template <class Real, class Intersector>
-const prism::SceneGeometry<Real, prism::Bvh<Intersector>>& geometry_of(const Workload& workload) {
-    using Geometry = prism::SceneGeometry<Real, prism::Bvh<Intersector>>;
+template <class Real, class Policy>
+const prism::SceneGeometry<Real, Policy>& geometry_of(const Workload& workload) {
+    using Geometry = prism::SceneGeometry<Real, Policy>;
     static std::map<const Workload*, std::unique_ptr<Geometry>> cache;
     std::unique_ptr<Geometry>& slot = cache[&workload];
     if (!slot) slot = std::make_unique<Geometry>(workload.scene);
@@ -178,7 +182,7 @@ void make_batches(Workload& workload) {
     const int height = std::max(1, int(std::lround(camera.height * scale)));
     const prism::PinholeCamera<double> pinhole(camera, width, height);
 
-    const ReferenceGeometry& reference = geometry_of<double, prism::Watertight>(workload);
+    const ReferenceGeometry& reference = geometry_of<double, prism::Bvh<prism::Watertight>>(workload);
     const auto bounds = reference.bounds();
     const double scene_radius = 0.5 * glm::length(bounds.max - bounds.min);
 
@@ -292,9 +296,9 @@ using Answers = std::vector<std::uint8_t>;
 using TraceBatch = void (*)(const Workload&, const RayBatch&, Answers&);
 using BuildBenchmark = void (*)(benchmark::State&, const Workload&);
 
-template <class Real, class Intersector>
+template <class Real, class Policy>
 void trace_prism(const Workload& workload, const RayBatch& batch, Answers& answers) {
-    const auto& geometry = geometry_of<Real, Intersector>(workload);
+    const auto& geometry = geometry_of<Real, Policy>(workload);
     const std::vector<Ray<Real>>& rays = batch.rays_in<Real>();
     if (batch.any_hit) {
         for (std::size_t i = 0; i < rays.size(); ++i) answers[i] = geometry.occluded(rays[i]);
@@ -307,10 +311,10 @@ void trace_prism(const Workload& workload, const RayBatch& batch, Answers& answe
     }
 }
 
-template <class Real, class Intersector>
+template <class Real, class Policy>
 void build_prism(benchmark::State& state, const Workload& workload) {
     for (auto _ : state) {
-        const prism::SceneGeometry<Real, prism::Bvh<Intersector>> geometry(workload.scene);
+        const prism::SceneGeometry<Real, Policy> geometry(workload.scene);
         benchmark::DoNotOptimize(geometry.bounds());
     }
 }
@@ -406,6 +410,13 @@ void build_embree(benchmark::State& state, const Workload& workload) {
 
 #endif  // PRISM_BENCH_WITH_EMBREE
 
+template <class Intersector>
+using Bvh = prism::Bvh<Intersector>;
+template <class Intersector, int Width>
+using Wide = prism::WideBvh<Intersector, Width>;
+template <prism::Precision P>
+using DefaultAcceleration = typename prism::PrecisionPolicy<P>::Acceleration;
+
 struct Variant {
     const char* name;
     bool robust;           // must agree with the double reference, else the benchmark stops
@@ -415,12 +426,27 @@ struct Variant {
 
 const std::vector<Variant>& variants() {
     static const std::vector<Variant> list{
-        {"naive_float", false, &trace_prism<float, prism::NaiveEpsilon>, nullptr},
-        {"naive_double", false, &trace_prism<double, prism::NaiveEpsilon>, nullptr},
-        {"watertight_float", true, &trace_prism<float, prism::Watertight>, &build_prism<float, prism::Watertight>},
-        {"watertight_double", true, &trace_prism<double, prism::Watertight>, &build_prism<double, prism::Watertight>},
-        {"double_refine_float", true, &trace_prism<float, prism::DoubleRefine>,
-         &build_prism<float, prism::DoubleRefine>},
+        {"naive_float", false, &trace_prism<float, Bvh<prism::NaiveEpsilon>>, nullptr},
+        {"naive_double", false, &trace_prism<double, Bvh<prism::NaiveEpsilon>>, nullptr},
+        {"watertight_float", true, &trace_prism<float, Bvh<prism::Watertight>>, &build_prism<float, Bvh<prism::Watertight>>},
+        {"watertight_double", true, &trace_prism<double, Bvh<prism::Watertight>>,
+         &build_prism<double, Bvh<prism::Watertight>>},
+        {"double_refine_float", true, &trace_prism<float, Bvh<prism::DoubleRefine>>,
+         &build_prism<float, Bvh<prism::DoubleRefine>>},
+        {"wide4_float", true, &trace_prism<float, Wide<prism::Watertight, 4>>, &build_prism<float, Wide<prism::Watertight, 4>>},
+        {"wide8_float", true, &trace_prism<float, Wide<prism::Watertight, 8>>, &build_prism<float, Wide<prism::Watertight, 8>>},
+        {"wide4_double", true, &trace_prism<double, Wide<prism::Watertight, 4>>,
+         &build_prism<double, Wide<prism::Watertight, 4>>},
+        {"wide8_double", true, &trace_prism<double, Wide<prism::Watertight, 8>>,
+         &build_prism<double, Wide<prism::Watertight, 8>>},
+        {"wide4_double_refine", true, &trace_prism<float, Wide<prism::DoubleRefine, 4>>, nullptr},
+        {"wide8_double_refine", true, &trace_prism<float, Wide<prism::DoubleRefine, 8>>, nullptr},
+        // The renderer's own choices (render/render_scene.hpp), whatever they are today: the
+        // ratio lines name them so their meaning survives a change of default.
+        {"default_float", true, &trace_prism<float, DefaultAcceleration<prism::Precision::single>>, nullptr},
+        {"default_double", true, &trace_prism<double, DefaultAcceleration<prism::Precision::double_all>>, nullptr},
+        {"default_double_refine", true, &trace_prism<float, DefaultAcceleration<prism::Precision::double_refine>>,
+         nullptr},
 #ifdef PRISM_BENCH_WITH_EMBREE
         {"embree", false, &trace_embree<false>, &build_embree<false>},
         {"embree_robust", false, &trace_embree<true>, &build_embree<true>},
@@ -468,7 +494,7 @@ const Answers& watertight_float_answers(const Workload& workload, BatchKind kind
     if (added) {
         const RayBatch& batch = workload.batches[std::size_t(kind)];
         found->second.resize(batch.rays.size());
-        trace_prism<float, prism::Watertight>(workload, batch, found->second);
+        trace_prism<float, Bvh<prism::Watertight>>(workload, batch, found->second);
     }
     return found->second;
 }
@@ -526,7 +552,19 @@ void build_benchmark(benchmark::State& state, WorkloadGetter get, const Variant&
 // clock; a ratio is taken within each round and the median over rounds is reported, with
 // its quartiles to show the noise.
 constexpr int paired_rounds = 21;
-constexpr std::array<std::pair<const char*, const char*>, 5> ratio_pairs{{
+constexpr std::array<std::pair<const char*, const char*>, 17> ratio_pairs{{
+    {"default_float", "embree"},
+    {"default_float", "embree_robust"},
+    {"default_double", "default_float"},
+    {"default_double_refine", "default_float"},
+    {"default_float", "watertight_float"},
+    {"wide4_float", "watertight_float"},
+    {"wide8_float", "wide4_float"},
+    {"wide4_double", "wide4_float"},
+    {"wide8_double", "wide4_double"},
+    {"wide4_double_refine", "wide4_float"},
+    {"wide8_double_refine", "wide4_double_refine"},
+    {"wide4_float", "embree"},
     {"watertight_float", "naive_float"},
     {"double_refine_float", "watertight_float"},
     {"watertight_double", "watertight_float"},
@@ -633,7 +671,7 @@ public:
                         const auto value = record.counters.find(key);
                         return value == record.counters.end() ? std::string("-") : std::to_string(std::llround(value->second));
                     };
-                    out << "    " << std::left << std::setw(20) << variant.name << std::right << std::setw(10)
+                    out << "    " << std::left << std::setw(24) << variant.name << std::right << std::setw(10)
                         << std::setprecision(2) << record.rate().value_or(0) * 1e-6 << std::setw(12) << counter("hits")
                         << std::setw(12) << counter("mismatches") << " (" << counter("lost") << ", " << counter("extra")
                         << ") of " << counter("rays");

@@ -25,6 +25,7 @@
 #include <sstream>
 #include <string>
 #include <type_traits>
+#include <typeinfo>
 #include <utility>
 #include <vector>
 
@@ -40,6 +41,14 @@ template <class Real>
 using BvhGeometry = prism::SceneGeometry<Real, prism::Bvh<prism::Watertight>>;
 template <class Real>
 using BruteGeometry = prism::SceneGeometry<Real, prism::BruteForce<prism::Watertight>>;
+
+// Runs `body.template operator()<Geometry>()` for the binary BVH and the wide BVHs (4 and 8).
+template <class Real, class Body>
+void for_each_bvh(Body body) {
+    body.template operator()<BvhGeometry<Real>>();
+    body.template operator()<prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 4>>>();
+    body.template operator()<prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>>();
+}
 
 // ---------------------------------------------------------------------------------------------
 // Scenes
@@ -239,7 +248,7 @@ void occluded_at_half(const Geometry& geometry, const std::vector<prism::Ray<Rea
 // The t that the watertight test gives for one triangle of the mesh or its instance (or the
 // sphere), with the ray taken to object space exactly as SceneGeometry does. Used to confirm
 // that two different answers are a genuine tie.
-template <class Real>
+template <class Real, class Intersector = prism::Watertight>
 bool direct_hit(const scene::Scene& world, const prism::Ray<Real>& world_ray, std::uint32_t object, long triangle,
                 Real& t) {
     prism::Ray<Real> ray = world_ray;
@@ -258,10 +267,11 @@ bool direct_hit(const scene::Scene& world, const prism::Ray<Real>& world_ray, st
     const scene::Mesh& mesh = world.meshes[0];
     const auto& face = mesh.triangles[std::size_t(triangle)];
     prism::TriangleHit<Real> hit;
-    const prism::Watertight::Prepared<Real> prepared(ray);
-    if (!prism::Watertight::intersect(prepared, prism::Vec3<Real>(mesh.positions[face[0]]),
-                                      prism::Vec3<Real>(mesh.positions[face[1]]),
-                                      prism::Vec3<Real>(mesh.positions[face[2]]), ray.t_min, prism::infinity<Real>, hit))
+    using Storage = typename Intersector::template Storage<Real>;
+    const typename Intersector::template Prepared<Real> prepared(ray);
+    if (!Intersector::intersect(prepared, prism::Vec3<Storage>(mesh.positions[face[0]]),
+                                prism::Vec3<Storage>(mesh.positions[face[1]]),
+                                prism::Vec3<Storage>(mesh.positions[face[2]]), ray.t_min, prism::infinity<Real>, hit))
         return false;
     t = hit.t;
     return true;
@@ -278,22 +288,34 @@ std::string describe(const prism::Ray<Real>& ray, const Trace<Real>& bvh, const 
     return out.str();
 }
 
-// Runs both geometries on the rays and counts every kind of disagreement; the first few are
-// printed so a failure can be reproduced.
-template <class Real>
+// Runs each policy's geometry and brute force (with the same intersector) on the rays and counts
+// every kind of disagreement; the first few are printed so a failure can be reproduced.
+template <class Real, class Intersector, class Policy>
+void compare_policy_with_brute_force(const scene::Scene& world, const std::vector<prism::Ray<Real>>& rays,
+                                     const std::vector<Trace<Real>>& brute_traces);
+
+template <class Real, class Intersector, class... Policies>
 void compare_with_brute_force(const scene::Scene& world, const std::vector<prism::Ray<Real>>& rays) {
-    const BvhGeometry<Real> bvh(world);
-    const BruteGeometry<Real> brute(world);
+    const prism::SceneGeometry<Real, prism::BruteForce<Intersector>> brute(world);
+    std::vector<Trace<Real>> brute_traces;
+    trace_all(brute, rays, any_hit_stride, brute_traces);
+    occluded_at_half(brute, rays, brute_traces, any_hit_stride, brute_traces);
+    (compare_policy_with_brute_force<Real, Intersector, Policies>(world, rays, brute_traces), ...);
+}
+
+template <class Real, class Intersector, class Policy>
+void compare_policy_with_brute_force(const scene::Scene& world, const std::vector<prism::Ray<Real>>& rays,
+                                     const std::vector<Trace<Real>>& brute_traces) {
+    static_assert(std::is_same_v<typename Policy::Intersector, Intersector>);
+    const prism::SceneGeometry<Real, Policy> bvh(world);
     const std::size_t copies = 1 + world.mesh_instances.size();
     REQUIRE(bvh.instance_count() == copies + 1);
     REQUIRE(bvh.triangle_count() == copies * world.meshes[0].triangles.size());
     const std::size_t sphere = copies;
 
-    std::vector<Trace<Real>> bvh_traces, brute_traces;
+    std::vector<Trace<Real>> bvh_traces;
     trace_all(bvh, rays, 1, bvh_traces);
-    trace_all(brute, rays, any_hit_stride, brute_traces);
     occluded_at_half(bvh, rays, brute_traces, 1, bvh_traces);
-    occluded_at_half(brute, rays, brute_traces, any_hit_stride, brute_traces);
 
     std::size_t hits = 0, ties = 0, per_object[3] = {0, 0, 0};  // mesh, instance, sphere
     std::size_t hit_mismatch = 0, t_mismatch = 0, identity_mismatch = 0, near_ties = 0, t_max_not_lowered = 0;
@@ -337,8 +359,8 @@ void compare_with_brute_force(const scene::Scene& world, const std::vector<prism
         }
         // Different primitives: acceptable only as a tie, both genuinely hit at the same t.
         Real t_a = -1, t_b = -1;
-        const bool real_a = direct_hit(world, rays[i], a.object, a.triangle, t_a);
-        const bool real_b = direct_hit(world, rays[i], b.object, b.triangle, t_b);
+        const bool real_a = direct_hit<Real, Intersector>(world, rays[i], a.object, a.triangle, t_a);
+        const bool real_b = direct_hit<Real, Intersector>(world, rays[i], b.object, b.triangle, t_b);
         if (real_a && real_b && t_a == a.t && t_b == b.t && a.t == b.t) {
             ++ties;
         } else if (a.t == b.t) {
@@ -349,7 +371,7 @@ void compare_with_brute_force(const scene::Scene& world, const std::vector<prism
             report(i, "different primitive at a different t");
         }
     }
-    MESSAGE(rays.size() << " rays: " << hits << " hits (mesh " << per_object[0] << ", instance " << per_object[1]
+    MESSAGE(std::string(typeid(Policy).name()) << ": " << rays.size() << " rays: " << hits << " hits (mesh " << per_object[0] << ", instance " << per_object[1]
                         << ", sphere " << per_object[2] << "), " << ties << " exact ties between triangles");
     // The ray set must exercise what it claims to: most rays hit, some miss, every object is hit.
     CHECK(hits > rays.size() / 2);
@@ -383,7 +405,9 @@ TEST_CASE_TEMPLATE("BVH closest hit and any hit equal brute force on a course me
     REQUIRE(ply.triangles.size() == 2880);
     const Bounds bounds = bounds_of(ply.positions);
     const scene::Scene world = mesh_scene(soup_with_triangle_ids(ply.positions, ply.triangles), bounds, false);
-    compare_with_brute_force(world, test_rays<Real>(bounds, ply.positions, 100'000, 2013));
+    compare_with_brute_force<Real, prism::Watertight, prism::Bvh<prism::Watertight>, prism::WideBvh<prism::Watertight, 4>,
+                             prism::WideBvh<prism::Watertight, 8>>(world,
+                                                                   test_rays<Real>(bounds, ply.positions, 100'000, 2013));
 }
 
 TEST_CASE_TEMPLATE("BVH closest hit and any hit equal brute force on a perturbed icosphere", Real, float, double) {
@@ -394,7 +418,11 @@ TEST_CASE_TEMPLATE("BVH closest hit and any hit equal brute force on a perturbed
     const Bounds bounds = bounds_of(positions);
     // The instance adds the transformed object space and the top-level index to the comparison.
     const scene::Scene world = mesh_scene(soup_with_triangle_ids(positions, triangles), bounds, true);
-    compare_with_brute_force(world, test_rays<Real>(bounds, positions, 10'000, 1980));
+    const auto rays = test_rays<Real>(bounds, positions, 10'000, 1980);
+    compare_with_brute_force<Real, prism::Watertight, prism::Bvh<prism::Watertight>, prism::WideBvh<prism::Watertight, 4>,
+                             prism::WideBvh<prism::Watertight, 8>>(world, rays);
+    compare_with_brute_force<Real, prism::DoubleRefine, prism::WideBvh<prism::DoubleRefine, 4>,
+                             prism::WideBvh<prism::DoubleRefine, 8>>(world, rays);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -613,9 +641,11 @@ TEST_CASE_TEMPLATE("BVH on one triangle: never culls a hit at a vertex or an edg
         mesh.positions = {triangle[0], triangle[1], triangle[2]};
         mesh.triangles = {{0, 1, 2}};
         world.meshes.push_back(mesh);
-        const BvhGeometry<Real> bvh(world);
         const prism::Vec3<Real> p0(triangle[0]), p1(triangle[1]), p2(triangle[2]);
-        for (const auto& ray : rays_at_triangle<Real>(triangle, 400, random)) {
+        const auto rays = rays_at_triangle<Real>(triangle, 400, random);
+        for_each_bvh<Real>([&]<class Geometry>() {
+        const Geometry bvh(world);
+        for (const auto& ray : rays) {
             ++rays_tested;
             prism::TriangleHit<Real> direct;
             const prism::Watertight::Prepared<Real> prepared(ray);
@@ -628,6 +658,7 @@ TEST_CASE_TEMPLATE("BVH on one triangle: never culls a hit at a vertex or an edg
             if (!expected && found) ++invented;
             if (expected && found && hit.t != direct.t) ++wrong_t;
         }
+        });
     }
     CHECK(direct_hits > rays_tested / 2);
     CHECK(lost == 0);
@@ -666,7 +697,8 @@ TEST_CASE_TEMPLATE("BVH on many copies of one triangle: hits like brute force", 
     mesh.positions = {{-1, -1, -3}, {1, -1, -3}, {0, 1, -3}};
     for (int i = 0; i < 1000; ++i) mesh.triangles.push_back({0, 1, 2});
     world.meshes.push_back(mesh);
-    const BvhGeometry<Real> bvh(world);
+    for_each_bvh<Real>([&]<class Geometry>() {
+    const Geometry bvh(world);
     const BruteGeometry<Real> brute(world);
     REQUIRE(bvh.triangle_count() == 1000);
     std::mt19937 random(3);
@@ -685,6 +717,7 @@ TEST_CASE_TEMPLATE("BVH on many copies of one triangle: hits like brute force", 
     CHECK(hits > 300);
     CHECK(hits < 2000);
     CHECK(disagreements == 0);
+    });
 }
 
 // SceneGeometry's contract: closest hit in (t_min, t_max], any hit in (t_min, t_max), for every
@@ -705,7 +738,8 @@ TEST_CASE_TEMPLATE("SceneGeometry: the hit interval is the same for triangles, s
         {{"triangle", &triangle_scene}, {"sphere", &sphere_scene}, {"plane", &plane_scene}}};
     for (const auto& [shape, world] : cases) {
         CAPTURE(shape);
-        const BvhGeometry<Real> geometry(*world);
+        for_each_bvh<Real>([&]<class Geometry>() {
+        const Geometry geometry(*world);
         const prism::Ray<Real> ray{prism::Vec3<Real>(0), prism::Vec3<Real>(0, 0, -1), Real(0), prism::infinity<Real>};
         prism::Hit<Real> hit;
         prism::Ray<Real> closed = ray;
@@ -726,6 +760,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: the hit interval is the same for triangles, s
         CHECK(geometry.occluded(shadow));
         shadow.t_max = Real(2);
         CHECK_FALSE(geometry.occluded(shadow));  // open at t_max: fails for the triangle today
+        });
     }
 }
 
@@ -738,7 +773,8 @@ TEST_CASE_TEMPLATE("SceneGeometry: back-face culling skips surfaces facing away,
     mesh.triangles = {{0, 1, 2}};
     world.meshes.push_back(mesh);
     world.planes.push_back({"floor", 0, {0, 0, -5}, {0, 0, 1}, glm::dmat4(1.0)});
-    const BvhGeometry<Real> geometry(world);
+    for_each_bvh<Real>([&]<class Geometry>() {
+    const Geometry geometry(world);
     const prism::Ray<Real> from_front{prism::Vec3<Real>(0, 0, 2), prism::Vec3<Real>(0, 0, -1)};
     const prism::Ray<Real> from_behind{prism::Vec3<Real>(0, 0, -10), prism::Vec3<Real>(0, 0, 1)};
     prism::Hit<Real> hit;
@@ -764,6 +800,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: back-face culling skips surfaces facing away,
     ray = from_behind;
     REQUIRE(geometry.template intersect<BackfaceCulling::flat_triangles>(ray, hit));
     CHECK(hit.object == 1);
+    });
 }
 
 TEST_CASE_TEMPLATE("SceneGeometry: the course's culling keeps smooth meshes and follows instances' transformations",
@@ -812,4 +849,125 @@ TEST_CASE_TEMPLATE("SceneGeometry: the course's culling keeps smooth meshes and 
     ray = from_front;
     REQUIRE(geometry.template intersect<BackfaceCulling::none>(ray, hit));
     CHECK(hit.t == doctest::Approx(9).epsilon(1e-6));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The wide BVH's structure
+
+namespace {
+
+// Every primitive in exactly one leaf, each leaf's range starting at a multiple of N and padded
+// with repeats of its last primitive, children inside their parent, leaves around their
+// primitives, every node reached once, empty child slots missed by every ray.
+template <class Real, int N>
+void check_wide_structure(const prism::WideBvhTree<Real, N>& tree, const std::vector<prism::Aabb<Real>>& boxes) {
+    const auto& nodes = tree.nodes();
+    const auto& order = tree.primitive_indices();
+    CHECK(order.size() % N == 0);
+    if (boxes.empty()) {
+        CHECK(nodes.empty());
+        return;
+    }
+    std::vector<int> listed(boxes.size(), 0), node_visits(nodes.size(), 0);
+    std::size_t misaligned = 0, bad_padding = 0, primitive_outside = 0, child_outside = 0, empty_slots = 0;
+    std::vector<std::pair<std::uint32_t, prism::Aabb<Real>>> stack{{0u, tree.bounds()}};
+    while (!stack.empty()) {
+        const auto [index, parent_box] = stack.back();
+        stack.pop_back();
+        REQUIRE(index < nodes.size());
+        ++node_visits[index];
+        const auto& node = nodes[index];
+        for (int c = 0; c < N; ++c) {
+            prism::Aabb<Real> box;
+            for (int axis = 0; axis < 3; ++axis) {
+                box.min[axis] = node.bounds[axis][c];
+                box.max[axis] = node.bounds[3 + axis][c];
+            }
+            if (box.is_empty()) {
+                ++empty_slots;
+                continue;
+            }
+            if (!contains(parent_box, box)) ++child_outside;
+            if (node.count[c] == 0) {
+                stack.push_back({node.child[c], box});
+                continue;
+            }
+            const std::uint32_t first = node.child[c], count = node.count[c];
+            if (first % N != 0) ++misaligned;
+            REQUIRE(first + count <= order.size());
+            for (std::uint32_t slot = first; slot < first + count; ++slot) {
+                ++listed[order[slot]];
+                if (!contains(box, boxes[order[slot]])) ++primitive_outside;
+            }
+            for (std::uint32_t slot = first + count; slot % N != 0; ++slot)
+                if (order[slot] != order[first + count - 1]) ++bad_padding;
+        }
+    }
+    CHECK(std::count(listed.begin(), listed.end(), 1) == std::ptrdiff_t(boxes.size()));
+    CHECK(std::count(node_visits.begin(), node_visits.end(), 1) == std::ptrdiff_t(nodes.size()));
+    CHECK(misaligned == 0);
+    CHECK(bad_padding == 0);
+    CHECK(primitive_outside == 0);
+    CHECK(child_outside == 0);
+    // The empty slots are missed, even by rays of unbounded length along and against each axis.
+    if (empty_slots > 0) {
+        std::size_t entered = 0;
+        for (int axis = 0; axis < 3; ++axis)
+            for (Real sign : {Real(1), Real(-1), Real(0)}) {
+                prism::Vec3<Real> direction(Real(0.25));
+                direction[axis] = sign;
+                const prism::Ray<Real> ray{tree.bounds().centroid(), direction, Real(0), prism::infinity<Real>};
+                // Entering an empty slot would re-enter the root: more leaves than there are.
+                std::size_t leaves = 0;
+                if (tree.traverse_any(ray, prism::infinity<Real>,
+                                      [&](std::uint32_t, std::uint32_t, Real&) { return ++leaves > order.size(); }))
+                    ++entered;
+            }
+        CHECK(entered == 0);
+    }
+}
+
+template <class Real, int N>
+void check_wide_trees() {
+    std::vector<glm::dvec3> positions;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    perturbed_sphere(4, 11, positions, triangles);
+    const auto sphere_boxes = triangle_boxes<Real>(positions, triangles);
+    check_wide_structure(prism::WideBvhTree<Real, N>::build(sphere_boxes), sphere_boxes);
+    std::vector<prism::Aabb<Real>> one_centre(1000, prism::Aabb<Real>{prism::Vec3<Real>(-1), prism::Vec3<Real>(1)});
+    check_wide_structure(prism::WideBvhTree<Real, N>::build(one_centre), one_centre);
+    for (std::size_t count : {0, 1, 3, N + 1}) {
+        const std::vector<prism::Aabb<Real>> few(sphere_boxes.begin(), sphere_boxes.begin() + std::ptrdiff_t(count));
+        check_wide_structure(prism::WideBvhTree<Real, N>::build(few), few);
+    }
+    // The geometric progression drives the binary build to its depth cap, leaving leaves of
+    // more than N primitives: traversal must still reach every one of them.
+    std::vector<prism::Aabb<Real>> boxes;
+    const int count = std::is_same_v<Real, float> ? 120 : 1000;
+    for (int i = 0; i < count; ++i) {
+        const Real x = std::ldexp(Real(1), -i);
+        boxes.push_back({prism::Vec3<Real>(x, 0, 0), prism::Vec3<Real>(x + x / 2, x / 2, x / 2)});
+    }
+    const auto tree = prism::WideBvhTree<Real, N>::build(boxes);
+    check_wide_structure(tree, boxes);
+    const auto& order = tree.primitive_indices();
+    std::size_t unreached = 0;
+    for (int i = 0; i < count; ++i) {
+        const Real x = std::ldexp(Real(1), -i);
+        const prism::Ray<Real> ray{prism::Vec3<Real>(x + x / 4, x / 4, 1), prism::Vec3<Real>(0, 0, -1), Real(0),
+                                   prism::infinity<Real>};
+        const bool reached = tree.traverse_any(ray, prism::infinity<Real>, [&](std::uint32_t first, std::uint32_t n, Real&) {
+            return std::find(order.begin() + first, order.begin() + first + n, std::uint32_t(i)) != order.begin() + first + n;
+        });
+        unreached += reached ? 0 : 1;
+    }
+    CHECK(unreached == 0);
+}
+
+}  // namespace
+
+TEST_CASE_TEMPLATE("Wide BVH structure (4 and 8 children): a mesh, one centroid, tiny inputs, a deep progression", Real,
+                   float, double) {
+    check_wide_trees<Real, 4>();
+    check_wide_trees<Real, 8>();
 }

@@ -5,6 +5,7 @@
 
 #include <prism/accel/bvh_tree.hpp>
 #include <prism/accel/primitive_list.hpp>
+#include <prism/accel/wide_bvh_tree.hpp>
 #include <prism/geometry/triangle_hit.hpp>
 #include <prism/geometry/watertight.hpp>
 
@@ -35,6 +36,15 @@ template <class IntersectorT = Watertight>
 struct Bvh {
     using Intersector = IntersectorT;
     template <Scalar Real> using Index = BvhTree<Real>;
+};
+
+// The wide BVH: N = 4 or 8 children per node, and leaves of N-wide triangle packets
+// (geometry/triangle_packets.hpp) that the policy's meshes keep beside their triangles.
+template <class IntersectorT = Watertight, int Width = 8>
+struct WideBvh {
+    using Intersector = IntersectorT;
+    static constexpr int packet_width = Width;
+    template <Scalar Real> using Index = WideBvhTree<Real, Width>;
 };
 
 template <class IntersectorT = Watertight>

@@ -6,6 +6,7 @@
 #include <prism/accel/accelerator.hpp>
 #include <prism/geometry/hit.hpp>
 #include <prism/geometry/surface_error.hpp>
+#include <prism/geometry/triangle_packets.hpp>
 #include <prism/math/floating_point.hpp>
 #include <prism/scene/scene.hpp>
 
@@ -26,8 +27,11 @@ public:
     using Storage = typename Intersector::template Storage<Real>;
     using Index = typename Policy::template Index<Real>;
     using Prepared = typename Intersector::template Prepared<Real>;
+    using Packets = typename TrianglePacketsOf<Policy, Real>::type;
+    static constexpr bool packed = !std::is_same_v<Packets, NoTrianglePackets>;
 
-    explicit TriangleMesh(const scene::Mesh& mesh) : smooth_(mesh.shading == scene::ShadingMode::smooth) {
+    explicit TriangleMesh(const scene::Mesh& mesh)
+        : smooth_(mesh.shading == scene::ShadingMode::smooth), triangle_count_(mesh.triangles.size()) {
         const std::size_t count = mesh.triangles.size();
         std::vector<Aabb<Real>> boxes(count);
         for (std::size_t i = 0; i < count; ++i) {
@@ -43,21 +47,24 @@ public:
             bounds_.extend(boxes[i]);
         }
         index_ = Index::build(boxes);
+        // An index may repeat primitives to pad its leaves (the wide BVH): slots then outnumber
+        // triangles, and the repeats are copies that no leaf callback reports.
         const auto& order = index_.primitive_indices();
-        triangles_.resize(count);
-        faces_.resize(count);
-        for (std::size_t slot = 0; slot < count; ++slot) {
+        triangles_.resize(order.size());
+        faces_.resize(order.size());
+        for (std::size_t slot = 0; slot < order.size(); ++slot) {
             const auto& face = mesh.triangles[order[slot]];
             faces_[slot] = face;
             for (int k = 0; k < 3; ++k) triangles_[slot][k] = Vec3<Storage>(mesh.positions[face[k]]);
         }
+        if constexpr (packed) packets_ = Packets(triangles_);
         if (smooth_) vertex_normals_ = smooth_normals(mesh);
         if (!mesh.uvs.empty())
             for (const auto& uv : mesh.uvs) uvs_.emplace_back(uv);
     }
 
     Aabb<Real> bounds() const { return bounds_; }
-    std::size_t triangle_count() const { return triangles_.size(); }
+    std::size_t triangle_count() const { return triangle_count_; }
     bool smooth() const { return smooth_; }  // shadingMode="smooth": normals interpolated from the vertices
     // What traversal reads: the index and the triangles its leaves test (not the shading data).
     std::size_t accelerator_bytes() const { return index_.memory_bytes() + triangles_.capacity() * sizeof(triangles_[0]); }
@@ -67,6 +74,17 @@ public:
     template <bool CullBackfaces>
     bool intersect(const Ray<Real>& ray, Real& t_max, Hit<Real>& hit) const {
         const Prepared prepared(ray);
+        if constexpr (packed) {
+            const typename Packets::PackedRay packed_ray(prepared);
+            bool found = false;
+            index_.traverse_closest(ray, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
+                const bool leaf_hit = packets_.template intersect<CullBackfaces>(packed_ray, ray.direction, first,
+                                                                                 count, ray.t_min, t_limit, hit);
+                found |= leaf_hit;
+                return leaf_hit;
+            });
+            return found;
+        }
         bool found = false;
         index_.traverse_closest(ray, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
             bool leaf_hit = false;
@@ -113,6 +131,12 @@ public:
 
     bool occluded(const Ray<Real>& ray, Real t_max) const {
         const Prepared prepared(ray);
+        if constexpr (packed) {
+            const typename Packets::PackedRay packed_ray(prepared);
+            return index_.traverse_any(ray, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
+                return packets_.occluded(packed_ray, first, count, ray.t_min, t_limit);
+            });
+        }
         return index_.traverse_any(ray, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
             for (std::uint32_t slot = first; slot < first + count; ++slot) {
                 const auto& p = triangles_[slot];
@@ -188,8 +212,10 @@ private:
     }
 
     bool smooth_ = false;
+    std::size_t triangle_count_ = 0;
     Aabb<Real> bounds_;
     Index index_;
+    [[no_unique_address]] Packets packets_;
     std::vector<std::array<Vec3<Storage>, 3>> triangles_;  // in index order
     std::vector<std::array<std::uint32_t, 3>> faces_;      // vertex indices, in index order
     std::vector<Vec3<Real>> vertex_normals_;

@@ -126,19 +126,21 @@ using AllLightSet = Lights<PointLight, DirectionalLight, SpotLight, AreaLight, E
 inline constexpr Features no_features{};
 inline constexpr Features all_features{.textures = true, .motion_blur = true};
 
-// What each precision builds: its scalar type and its acceleration policy.
+// What each precision builds: its scalar type and its acceleration policy. The 8-wide BVH beat
+// the 4-wide one on every batch but one of bench/intersect_bench.cpp (AVX2 build: 0.72-0.85 of
+// its time in float, 0.69-0.98 in double; bench/RESULTS.md), and the binary BVH by 1.6-2.1x.
 template <Precision P> struct PrecisionPolicy;
 template <> struct PrecisionPolicy<Precision::single> {
     using Real = float;
-    using Acceleration = Bvh<Watertight>;
+    using Acceleration = WideBvh<Watertight, 8>;
 };
 template <> struct PrecisionPolicy<Precision::double_refine> {
     using Real = float;
-    using Acceleration = Bvh<DoubleRefine>;
+    using Acceleration = WideBvh<DoubleRefine, 8>;
 };
 template <> struct PrecisionPolicy<Precision::double_all> {
     using Real = double;
-    using Acceleration = Bvh<Watertight>;
+    using Acceleration = WideBvh<Watertight, 8>;
 };
 
 template <class... Configs> struct ConfigList {};

@@ -1,0 +1,285 @@
+// A wide BVH: every node has up to N children (4 or 8) whose boxes are stored SoA, so one SIMD
+// slab test (simd/pack.hpp) decides them all. Built by collapsing the binned-SAH binary tree
+// (accel/bvh_tree.hpp): a node repeatedly adopts the grandchildren of its largest-area inner
+// child until it has N children (Wald, Benthin, Boulos 2008, "Getting rid of packets"; the
+// collapse of Embree's BVH4/BVH8 and of tinybvh's BVH8_CPU). Traversal is nearest first for the
+// closest hit and in stack order for any hit. Like BvhTree it holds no primitives: a leaf hands
+// its range of primitive_indices to a callback.
+//
+// Leaves are sized for N-wide triangle packets: a binary subtree of at most N primitives becomes
+// one leaf, and every leaf's range starts at a multiple of N, padded up to the next multiple of
+// N with repeats of its last primitive. A leaf callback still gets the true count; the padding
+// only lets packet k of a mesh be slots [k N, k N + N) (geometry/triangle_packets.hpp).
+#pragma once
+
+#include <prism/accel/bvh_tree.hpp>
+#include <prism/simd/pack.hpp>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace prism {
+
+template <Scalar Real, int N>
+struct alignas(64) WideBvhNode {
+    // bounds[axis][child] is the low plane, bounds[3 + axis][child] the high one. An empty
+    // child slot is the empty box (low +inf, high -inf): entered at +inf and left at -inf
+    // whatever the direction's sign, it is missed even by a ray with t_max = inf.
+    Real bounds[6][N];
+    std::uint32_t child[N];  // inner child: node index; leaf: first slot in primitive_indices
+    std::uint32_t count[N];  // leaf: primitive count; 0: inner child (or empty slot)
+};
+
+template <Scalar Real, int N>
+class WideBvhTree {
+    static_assert(N == 4 || N == 8, "a wide BVH node has 4 or 8 children");
+
+public:
+    static constexpr int width = N;
+    // The binary tree's depth limit bounds the collapsed tree's depth too; each level pushes at
+    // most N - 1 children.
+    static constexpr int stack_size = BvhTree<Real>::max_depth * (N - 1) + 1;
+
+    WideBvhTree() = default;
+
+    static WideBvhTree build(std::span<const Aabb<Real>> boxes) {
+        BvhBuildOptions options;
+        options.max_leaf_size = N;
+        const BvhTree<Real> binary = BvhTree<Real>::build(boxes, options);
+        WideBvhTree tree;
+        if (boxes.empty()) return tree;
+        tree.bounds_ = binary.bounds();
+        Collapser collapser{binary, tree, {}};
+        collapser.ranges.resize(binary.nodes().size());
+        collapser.measure(0);
+        if (binary.nodes()[0].is_leaf()) {
+            // One leaf: a root with a single child keeps traversal uniform.
+            const std::uint32_t root = tree.new_node();
+            collapser.fill_child(root, 0, 0);
+        } else {
+            collapser.collapse(0);
+        }
+        tree.primitive_indices_.shrink_to_fit();
+        return tree;
+    }
+
+    const std::vector<WideBvhNode<Real, N>>& nodes() const { return nodes_; }
+    // Leaf ranges padded to multiples of N (see the top of this file).
+    const std::vector<std::uint32_t>& primitive_indices() const { return primitive_indices_; }
+    Aabb<Real> bounds() const { return bounds_; }
+    std::size_t memory_bytes() const {
+        return nodes_.capacity() * sizeof(WideBvhNode<Real, N>) + primitive_indices_.capacity() * sizeof(std::uint32_t);
+    }
+
+    template <class Leaf>
+    void traverse_closest(const Ray<Real>& ray, Real& t_max, Leaf&& leaf) const {
+        traverse<false>(ray, t_max, leaf);
+    }
+
+    template <class Leaf>
+    bool traverse_any(const Ray<Real>& ray, Real t_max, Leaf&& leaf) const {
+        return traverse<true>(ray, t_max, leaf);
+    }
+
+private:
+    using Pack = simd::Pack<Real, N>;
+    // Ize's conservative far distance, as in BvhTree: every exit distance times 1 + 2 gamma(3).
+    static constexpr Real far_scale = Real(1) + 2 * gamma<Real>(3);
+
+    struct RaySlabs {
+        Pack origin[3], inverse_direction[3];
+        int near_plane[3], far_plane[3];  // rows of WideBvhNode::bounds, by the direction's sign
+
+        explicit RaySlabs(const Ray<Real>& ray) {
+            const RayBoxPrecomputed<Real> box_ray(ray);
+            for (int axis = 0; axis < 3; ++axis) {
+                origin[axis] = Pack::broadcast(box_ray.origin[axis]);
+                inverse_direction[axis] = Pack::broadcast(box_ray.inverse_direction[axis]);
+                // The sign decides which plane is entered, so no per-child min/max: the same
+                // order the scalar test's swap finds (1/-0 = -inf enters by the high plane).
+                const bool negative = std::signbit(box_ray.inverse_direction[axis]);
+                near_plane[axis] = negative ? 3 + axis : axis;
+                far_plane[axis] = negative ? axis : 3 + axis;
+            }
+        }
+    };
+
+    // Every child's entry distance; the mask says which children the ray enters within
+    // [t_min, t_max]. A NaN distance (0 * inf, a ray in a slab's plane) constrains nothing,
+    // as in the scalar intersect_box.
+    [[gnu::always_inline]] static simd::Mask<Real, N> enter(const WideBvhNode<Real, N>& node, const RaySlabs& ray, Real t_min, Real t_max,
+                                     Pack& entry) {
+        const Pack scale = Pack::broadcast(far_scale);
+        Pack t_enter = Pack::broadcast(t_min);
+        Pack t_exit = Pack::broadcast(t_max * far_scale);
+        for (int axis = 0; axis < 3; ++axis) {
+            const Pack t_near = (Pack::load(node.bounds[ray.near_plane[axis]]) - ray.origin[axis]) *
+                                ray.inverse_direction[axis];
+            const Pack t_far = (Pack::load(node.bounds[ray.far_plane[axis]]) - ray.origin[axis]) *
+                               ray.inverse_direction[axis] * scale;
+            t_enter = simd::max_keep(t_near, t_enter);
+            t_exit = simd::min_keep(t_far, t_exit);
+        }
+        entry = t_enter;
+        return t_enter <= t_exit;
+    }
+
+    struct StackEntry {
+        std::uint32_t child;
+        std::uint32_t count;  // 0: an inner node
+        Real distance;        // where the ray enters its box
+    };
+
+    template <bool AnyHit, class Leaf>
+    bool traverse(const Ray<Real>& ray, Real& t_max, Leaf& leaf) const {
+        if (nodes_.empty()) return false;
+        const RaySlabs slabs(ray);
+        std::array<StackEntry, stack_size> stack;
+        int size = 0;
+        bool found = false;
+        alignas(64) Real distances[N];
+        std::uint32_t current = 0;  // the inner node to test next
+        for (;;) {
+            const WideBvhNode<Real, N>& node = nodes_[current];
+            Pack entry_distances;
+            std::uint32_t hits = enter(node, slabs, ray.t_min, t_max, entry_distances).bits();
+            bool descend = false;
+            if (hits != 0 && (hits & (hits - 1)) == 0) {
+                // One child entered, the common case deep in the tree: no stack, no sort.
+                const int i = std::countr_zero(hits);
+                if (node.count[i] == 0) {
+                    current = node.child[i];
+                    continue;
+                }
+                if (leaf(node.child[i], node.count[i], t_max)) {
+                    found = true;
+                    if constexpr (AnyHit) return true;
+                }
+            } else if (hits != 0) {
+                entry_distances.store(distances);
+                // Push the entered children farthest first, so the nearest is popped next: an
+                // insertion sort into the top of the stack, at most N - 1 moves per child.
+                const int base = size;
+                while (hits != 0) {
+                    const int i = std::countr_zero(hits);
+                    hits &= hits - 1;
+                    const StackEntry pushed{node.child[i], node.count[i], distances[i]};
+                    int slot = size++;
+                    if constexpr (!AnyHit) {
+                        while (slot > base && stack[slot - 1].distance < pushed.distance) {
+                            stack[slot] = stack[slot - 1];
+                            --slot;
+                        }
+                    }
+                    stack[slot] = pushed;
+                }
+            }
+            // Pop until an inner node to descend into; leaves on the way are tested at once.
+            while (size > 0) {
+                const StackEntry entry = stack[--size];
+                // A box entered beyond the closest hit so far cannot hold a closer one (compared
+                // with the widened t_max the box test itself uses).
+                if constexpr (!AnyHit) {
+                    if (entry.distance > t_max * far_scale) continue;
+                }
+                if (entry.count == 0) {
+                    current = entry.child;
+                    descend = true;
+                    break;
+                }
+                if (leaf(entry.child, entry.count, t_max)) {
+                    found = true;
+                    if constexpr (AnyHit) return true;
+                }
+            }
+            if (!descend) return found;
+        }
+    }
+
+    std::uint32_t new_node() {
+        WideBvhNode<Real, N> node;
+        for (int row = 0; row < 6; ++row)
+            for (Real& plane : node.bounds[row]) plane = row < 3 ? infinity<Real> : -infinity<Real>;
+        for (int i = 0; i < N; ++i) node.child[i] = node.count[i] = 0;
+        nodes_.push_back(node);
+        return std::uint32_t(nodes_.size() - 1);
+    }
+
+    struct Collapser {
+        const BvhTree<Real>& binary;
+        WideBvhTree& tree;
+        struct Range {
+            std::uint32_t begin, end;
+        };
+        std::vector<Range> ranges;  // each binary node's contiguous range of primitive_indices
+
+        Range measure(std::uint32_t i) {
+            const BvhNode<Real>& node = binary.nodes()[i];
+            if (node.is_leaf()) return ranges[i] = {node.index, node.index + node.count};
+            const Range left = measure(node.index), right = measure(node.index + 1);
+            return ranges[i] = {left.begin, right.end};
+        }
+
+        bool becomes_leaf(std::uint32_t i) const { return ranges[i].end - ranges[i].begin <= std::uint32_t(N) || binary.nodes()[i].is_leaf(); }
+
+        // Makes the wide node for binary inner node i; returns its index.
+        std::uint32_t collapse(std::uint32_t i) {
+            const auto& nodes = binary.nodes();
+            std::array<std::uint32_t, N> children{};
+            int child_count = 2;
+            children[0] = nodes[i].index;
+            children[1] = nodes[i].index + 1;
+            while (child_count < N) {
+                int largest = -1;
+                Real largest_area = -1;
+                for (int c = 0; c < child_count; ++c) {
+                    if (becomes_leaf(children[c])) continue;
+                    const Real area = nodes[children[c]].bounds.half_area();
+                    if (area > largest_area) {
+                        largest_area = area;
+                        largest = c;
+                    }
+                }
+                if (largest < 0) break;
+                const std::uint32_t opened = children[largest];
+                children[largest] = nodes[opened].index;
+                children[child_count++] = nodes[opened].index + 1;
+            }
+            const std::uint32_t wide = tree.new_node();
+            for (int c = 0; c < child_count; ++c) fill_child(wide, c, children[c]);
+            return wide;
+        }
+
+        void fill_child(std::uint32_t wide, int slot, std::uint32_t i) {
+            const Aabb<Real>& box = binary.nodes()[i].bounds;
+            for (int axis = 0; axis < 3; ++axis) {
+                tree.nodes_[wide].bounds[axis][slot] = box.min[axis];
+                tree.nodes_[wide].bounds[3 + axis][slot] = box.max[axis];
+            }
+            if (becomes_leaf(i)) {
+                auto& indices = tree.primitive_indices_;
+                const auto& binary_indices = binary.primitive_indices();
+                const Range range = ranges[i];
+                tree.nodes_[wide].child[slot] = std::uint32_t(indices.size());
+                tree.nodes_[wide].count[slot] = range.end - range.begin;
+                indices.insert(indices.end(), binary_indices.begin() + range.begin, binary_indices.begin() + range.end);
+                while (indices.size() % N != 0) indices.push_back(indices.back());
+            } else {
+                const std::uint32_t node = collapse(i);  // may reallocate nodes_: index again
+                tree.nodes_[wide].child[slot] = node;
+                tree.nodes_[wide].count[slot] = 0;
+            }
+        }
+    };
+
+    std::vector<WideBvhNode<Real, N>> nodes_;
+    std::vector<std::uint32_t> primitive_indices_;
+    Aabb<Real> bounds_;
+};
+
+}  // namespace prism

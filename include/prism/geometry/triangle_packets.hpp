@@ -1,0 +1,213 @@
+// A mesh's triangles packed N at a time, SoA, for the wide BVH's leaves, and the watertight
+// test (geometry/watertight.hpp, Woop, Benthin, Wald 2013) run on a whole packet with one SIMD
+// instruction stream (simd/pack.hpp). It computes every lane with the scalar test's operations
+// in the scalar test's order, so each lane's edge functions, t and barycentrics are the scalar
+// test's bits; the lanes that pass are then accepted one by one in slot order against the
+// shrinking t_max, exactly as the scalar leaf loop does. The packed test is therefore as
+// watertight as the scalar one and picks the same triangle on every tie.
+// DoubleRefine runs the same test on packets of double vertices under float traversal.
+#pragma once
+
+#include <prism/geometry/double_refine.hpp>
+#include <prism/geometry/hit.hpp>
+#include <prism/geometry/watertight.hpp>
+#include <prism/simd/pack.hpp>
+
+#include <array>
+#include <bit>
+#include <concepts>
+#include <cstdint>
+#include <type_traits>
+#include <vector>
+
+namespace prism {
+
+// The intersectors with a packed test; the others (NaiveEpsilon) stay scalar in a wide BVH.
+template <class I>
+concept PacketIntersector = std::same_as<I, Watertight> || std::same_as<I, DoubleRefine>;
+
+template <class Intersector, Scalar Real, int N>
+class TrianglePackets {
+public:
+    using Storage = typename Intersector::template Storage<Real>;
+    using Prepared = typename Intersector::template Prepared<Real>;
+    using Pack = simd::Pack<Storage, N>;
+
+    // What the packed test needs of a ray, broadcast once per ray.
+    struct PackedRay {
+        int kx, ky, kz;
+        Pack origin[3];
+        Pack sx, sy, sz;
+        explicit PackedRay(const Prepared& prepared) {
+            const Watertight::Prepared<Storage>& ray = watertight_ray(prepared);
+            kx = ray.kx;
+            ky = ray.ky;
+            kz = ray.kz;
+            for (int axis = 0; axis < 3; ++axis) origin[axis] = Pack::broadcast(ray.origin[axis]);
+            sx = Pack::broadcast(ray.sx);
+            sy = Pack::broadcast(ray.sy);
+            sz = Pack::broadcast(ray.sz);
+        }
+    };
+
+    TrianglePackets() = default;
+
+    // `triangles` in slot order, a multiple of N of them (the wide BVH pads its leaves).
+    explicit TrianglePackets(const std::vector<std::array<Vec3<Storage>, 3>>& triangles) {
+        packets_.resize(triangles.size() / N);
+        normals_.resize(triangles.size());
+        for (std::size_t slot = 0; slot < triangles.size(); ++slot) {
+            Packet& packet = packets_[slot / N];
+            const auto& p = triangles[slot];
+            for (int vertex = 0; vertex < 3; ++vertex)
+                for (int axis = 0; axis < 3; ++axis) packet.vertices[vertex][axis][slot % N] = p[vertex][axis];
+            // The back-face test's normal, rounded as TriangleMesh's scalar loop rounds it.
+            normals_[slot] = Vec3<Real>(glm::cross(p[1] - p[0], p[2] - p[0]));
+        }
+    }
+
+    std::size_t memory_bytes() const {
+        return packets_.capacity() * sizeof(Packet) + normals_.capacity() * sizeof(Vec3<Real>);
+    }
+
+    // Closest hit among slots [first, first + count) (first a multiple of N); lowers t_limit.
+    template <bool CullBackfaces>
+    bool intersect(const PackedRay& ray, const Vec3<Real>& direction, std::uint32_t first, std::uint32_t count,
+                   Real t_min, Real& t_limit, Hit<Real>& hit) const {
+        bool found = false;
+        for (std::uint32_t base = first; base < first + count; base += N) {
+            alignas(64) Storage t[N], b1[N], b2[N];
+            std::uint32_t lanes = test(packets_[base / N], ray, Storage(t_min), Storage(t_limit), t, b1, b2);
+            lanes &= lane_mask(first + count - base);
+            while (lanes != 0) {
+                const int lane = std::countr_zero(lanes);
+                lanes &= lanes - 1;
+                const std::uint32_t slot = base + std::uint32_t(lane);
+                if constexpr (CullBackfaces) {
+                    if (glm::dot(normals_[slot], direction) > 0) continue;
+                }
+                // The scalar loop's acceptance, lane by lane in slot order: later ties win.
+                if (!(t[lane] <= Storage(t_limit))) continue;
+                t_limit = Real(t[lane]);
+                hit.t = t_limit;
+                hit.primitive = slot;
+                hit.b1 = Real(b1[lane]);
+                hit.b2 = Real(b2[lane]);
+                found = true;
+            }
+        }
+        return found;
+    }
+
+    // Whether any of slots [first, first + count) is hit in (t_min, t_limit).
+    bool occluded(const PackedRay& ray, std::uint32_t first, std::uint32_t count, Real t_min, Real t_limit) const {
+        for (std::uint32_t base = first; base < first + count; base += N) {
+            alignas(64) Storage t[N], b1[N], b2[N];
+            std::uint32_t lanes = test(packets_[base / N], ray, Storage(t_min), Storage(t_limit), t, b1, b2);
+            lanes &= lane_mask(first + count - base);
+            while (lanes != 0) {
+                const int lane = std::countr_zero(lanes);
+                lanes &= lanes - 1;
+                // Open at t_max, as TriangleMesh's scalar test, on t rounded to Real.
+                if (Real(t[lane]) < t_limit) return true;
+            }
+        }
+        return false;
+    }
+
+private:
+    struct alignas(64) Packet {
+        Storage vertices[3][3][N];  // [vertex][axis][lane]
+    };
+
+    static const Watertight::Prepared<Storage>& watertight_ray(const Prepared& prepared) {
+        if constexpr (std::is_same_v<Intersector, DoubleRefine>)
+            return prepared.ray;
+        else
+            return prepared;
+    }
+
+    static std::uint32_t lane_mask(std::uint32_t remaining) {
+        return remaining >= std::uint32_t(N) ? (std::uint32_t(1) << N) - 1 : (std::uint32_t(1) << remaining) - 1;
+    }
+
+    // Watertight::intersect on every lane: the lanes hit in (t_min, t_max], with their t and
+    // barycentrics stored. Same operations, same order, so the same bits as the scalar test.
+    [[gnu::always_inline]] static std::uint32_t test(const Packet& packet, const PackedRay& ray, Storage t_min, Storage t_max,
+                              Storage* t_out, Storage* b1_out, Storage* b2_out) {
+        const auto relative = [&](int vertex, int axis) {
+            return Pack::load(packet.vertices[vertex][axis]) - ray.origin[axis];
+        };
+        const Pack a_z = relative(0, ray.kz), b_z = relative(1, ray.kz), c_z = relative(2, ray.kz);
+        const Pack ax = relative(0, ray.kx) - ray.sx * a_z;
+        const Pack ay = relative(0, ray.ky) - ray.sy * a_z;
+        const Pack bx = relative(1, ray.kx) - ray.sx * b_z;
+        const Pack by = relative(1, ray.ky) - ray.sy * b_z;
+        const Pack cx = relative(2, ray.kx) - ray.sx * c_z;
+        const Pack cy = relative(2, ray.ky) - ray.sy * c_z;
+
+        Pack u = cx * by - cy * bx;
+        Pack v = ax * cy - ay * cx;
+        Pack w = bx * ay - by * ax;
+        const Pack zero = Pack::broadcast(0);
+        if constexpr (std::is_same_v<Storage, float>) {
+            // The paper's fallback to double on an exactly zero edge function, lane by lane.
+            if (std::uint32_t zeros = ((u == zero) | (v == zero) | (w == zero)).bits()) {
+                alignas(64) float lanes[8][N];
+                const Pack* inputs[6] = {&ax, &ay, &bx, &by, &cx, &cy};
+                for (int k = 0; k < 6; ++k) inputs[k]->store(lanes[k]);
+                u.store(lanes[6]);
+                v.store(lanes[7]);
+                alignas(64) float w_lanes[N];
+                w.store(w_lanes);
+                while (zeros != 0) {
+                    const int i = std::countr_zero(zeros);
+                    zeros &= zeros - 1;
+                    const double dax = lanes[0][i], day = lanes[1][i], dbx = lanes[2][i], dby = lanes[3][i],
+                                 dcx = lanes[4][i], dcy = lanes[5][i];
+                    lanes[6][i] = float(dcx * dby - dcy * dbx);
+                    lanes[7][i] = float(dax * dcy - day * dcx);
+                    w_lanes[i] = float(dbx * day - dby * dax);
+                }
+                u = Pack::load(lanes[6]);
+                v = Pack::load(lanes[7]);
+                w = Pack::load(w_lanes);
+            }
+        }
+        const auto outside = ((u < zero) | (v < zero) | (w < zero)) & ((u > zero) | (v > zero) | (w > zero));
+        const Pack det = u + v + w;
+        auto accepted = (!outside) & (det != zero);
+        if (!accepted.any()) return 0;
+
+        const Pack az = ray.sz * a_z, bz = ray.sz * b_z, cz = ray.sz * c_z;
+        const Pack t_scaled = u * az + v * bz + w * cz;
+        const Pack inverse_det = Pack::broadcast(1) / det;
+        const Pack t = t_scaled * inverse_det;
+        accepted = accepted & (t > Pack::broadcast(t_min)) & (t <= Pack::broadcast(t_max));
+        const std::uint32_t lanes = accepted.bits();
+        if (lanes == 0) return 0;
+        t.store(t_out);
+        (v * inverse_det).store(b1_out);
+        (w * inverse_det).store(b2_out);
+        return lanes;
+    }
+
+    std::vector<Packet> packets_;
+    std::vector<Vec3<Real>> normals_;  // per slot, read only when culling back faces
+};
+
+// The packets a policy's meshes keep: none for the binary BVH, brute force or a scalar-only
+// intersector; TrianglePackets for a wide BVH (a policy with a packet_width) of a packed test.
+struct NoTrianglePackets {};
+
+template <class Policy, class Real, bool = requires { Policy::packet_width; } &&
+                                          PacketIntersector<typename Policy::Intersector>>
+struct TrianglePacketsOf {
+    using type = NoTrianglePackets;
+};
+template <class Policy, class Real>
+struct TrianglePacketsOf<Policy, Real, true> {
+    using type = TrianglePackets<typename Policy::Intersector, Real, Policy::packet_width>;
+};
+
+}  // namespace prism
