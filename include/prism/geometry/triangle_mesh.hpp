@@ -67,7 +67,11 @@ public:
     std::size_t triangle_count() const { return triangle_count_; }
     bool smooth() const { return smooth_; }  // shadingMode="smooth": normals interpolated from the vertices
     // What traversal reads: the index and the triangles its leaves test (not the shading data).
-    std::size_t accelerator_bytes() const { return index_.memory_bytes() + triangles_.capacity() * sizeof(triangles_[0]); }
+    std::size_t accelerator_bytes() const {
+        std::size_t bytes = index_.memory_bytes() + triangles_.capacity() * sizeof(triangles_[0]);
+        if constexpr (packed) bytes += packets_.memory_bytes();
+        return bytes;
+    }
 
     // Closest hit along `ray` (object space) below t_max; lowers t_max and fills t, primitive,
     // barycentrics. Culling skips triangles whose winding faces away from the ray.
