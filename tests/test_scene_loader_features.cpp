@@ -648,7 +648,7 @@ TEST_CASE("faults in textures, images and the new lights name the file and the e
          "<ImageName>", "nowhere.jpg: no such image file"},
         {"undecodable_image.xml", R"(<Images><Image id="1">broken.png</Image></Images>
         <TextureMap id="1" type="image"><ImageId>1</ImageId></TextureMap>)",
-         "<Image id=\"1\">", "cannot read the image"},
+         "<Image id=\"1\">", "the file's content is not the png image its name says"},
         {"unknown_image_format.xml", R"(<Images><Image id="1">textures/small.gif</Image></Images>)",
          "<Image id=\"1\">", "unsupported image format"},
         {"unknown_decal_mode.xml", R"(<TextureMap id="1" type="perlin"><DecalMode>replace_diffuse</DecalMode></TextureMap>)",
