@@ -30,4 +30,20 @@ enum class BackfaceCulling {
     all,             // camera rays skip every back-facing triangle and plane
 };
 
+// The closest hit for an integrator: camera rays (depth 0) skip back faces as `culling` says,
+// every other ray sees both sides. One place, so the ray tracer and the path tracer see the same
+// first surfaces.
+template <class Geometry, class RayT, class HitT>
+bool intersect_culled(const Geometry& geometry, BackfaceCulling culling, int depth, RayT& ray, HitT& hit) {
+    if (depth == 0) {
+        switch (culling) {
+            case BackfaceCulling::none: break;
+            case BackfaceCulling::flat_triangles:
+                return geometry.template intersect<BackfaceCulling::flat_triangles>(ray, hit);
+            case BackfaceCulling::all: return geometry.template intersect<BackfaceCulling::all>(ray, hit);
+        }
+    }
+    return geometry.template intersect<BackfaceCulling::none>(ray, hit);
+}
+
 }  // namespace prism

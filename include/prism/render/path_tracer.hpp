@@ -18,6 +18,7 @@
 // ray tracer, which this integrator holds.
 #pragma once
 
+#include <prism/geometry/backface_culling.hpp>
 #include <prism/light/environment_light.hpp>
 #include <prism/light/light_mesh.hpp>
 #include <prism/light/light_sphere.hpp>
@@ -170,18 +171,8 @@ private:
         return color;
     }
 
-    // The closest hit, camera rays skipping back faces as the ray tracer does
-    // (settings_.backface_culling), so both integrators see the same first surfaces.
     bool intersect(Ray<Real>& ray, int depth, Hit<Real>& hit) const {
-        if (depth == 0) {
-            switch (settings_.backface_culling) {
-                case BackfaceCulling::none: break;
-                case BackfaceCulling::flat_triangles:
-                    return geometry_.template intersect<BackfaceCulling::flat_triangles>(ray, hit);
-                case BackfaceCulling::all: return geometry_.template intersect<BackfaceCulling::all>(ray, hit);
-            }
-        }
-        return geometry_.template intersect<BackfaceCulling::none>(ray, hit);
+        return intersect_culled(geometry_, settings_.backface_culling, depth, ray, hit);
     }
 
     // Mirrors and conductors reflect; dielectrics reflect or refract, chosen by the Fresnel

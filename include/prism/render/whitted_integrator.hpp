@@ -157,17 +157,8 @@ private:
         return color;
     }
 
-    // The closest hit, skipping back faces as settings_.backface_culling says for camera rays.
     bool intersect(Ray<Real>& ray, int depth, Hit<Real>& hit) const {
-        if (depth == 0) {
-            switch (settings_.backface_culling) {
-                case BackfaceCulling::none: break;
-                case BackfaceCulling::flat_triangles:
-                    return geometry_.template intersect<BackfaceCulling::flat_triangles>(ray, hit);
-                case BackfaceCulling::all: return geometry_.template intersect<BackfaceCulling::all>(ray, hit);
-            }
-        }
-        return geometry_.template intersect<BackfaceCulling::none>(ray, hit);
+        return intersect_culled(geometry_, settings_.backface_culling, depth, ray, hit);
     }
 
     // A ray that meets nothing: primary rays show the background (texture, environment or
