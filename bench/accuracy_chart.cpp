@@ -20,6 +20,9 @@
 #include <prism/render/renderer.hpp>
 #include <prism/scene/stress.hpp>
 
+#include "run_record.hpp"
+#include "svg_plot.hpp"
+
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
@@ -53,30 +56,10 @@
 namespace {
 
 namespace fs = std::filesystem;
+using namespace prism::bench;
 using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-// CPU time of the whole process (every thread), in seconds. On a shared machine it measures the
-// work a render does; wall-clock time also counts the other jobs that held the cores.
-double process_cpu_seconds() {
-    timespec now{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
-    return double(now.tv_sec) + 1e-9 * double(now.tv_nsec);
-}
-
-// Times of the runs of one measurement.
-struct Times {
-    std::vector<double> seconds;
-    double median() const {
-        std::vector<double> sorted = seconds;
-        std::sort(sorted.begin(), sorted.end());
-        const std::size_t n = sorted.size();
-        return n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
-    }
-    double fastest() const { return *std::min_element(seconds.begin(), seconds.end()); }
-    double slowest() const { return *std::max_element(seconds.begin(), seconds.end()); }
-};
 
 // ---------------------------------------------------------------------------------------------
 // What is rendered
@@ -324,72 +307,6 @@ SceneResult measure_scene(std::size_t scene_index, const Options& options) {
 // The chart (SVG): render time relative to the scene's reference on x, error on a log y axis,
 // one panel per error measure.
 
-struct LogAxis {
-    int floor_decade, top_decade;  // 10^floor_decade is where zero errors are drawn
-};
-
-LogAxis log_axis(const std::vector<double>& values, double at_least_top) {
-    double smallest = at_least_top, largest = at_least_top;
-    for (const double value : values)
-        if (value > 0) {
-            smallest = std::min(smallest, value);
-            largest = std::max(largest, value);
-        }
-    // One empty decade between the smallest error and the floor keeps zero apart from "small".
-    return {int(std::floor(std::log10(smallest))) - 1, int(std::ceil(std::log10(largest)))};
-}
-
-std::string format_number(double value, int precision) {
-    std::ostringstream out;
-    out << std::setprecision(precision) << value;
-    return out.str();
-}
-
-std::string escape_xml(const std::string& text) {
-    std::string out;
-    for (const char c : text) {
-        if (c == '&') out += "&amp;";
-        else if (c == '<') out += "&lt;";
-        else if (c == '>') out += "&gt;";
-        else out += c;
-    }
-    return out;
-}
-
-std::string marker_svg(const std::string& shape, double x, double y, const std::string& colour) {
-    const double r = 6.5;
-    std::ostringstream out;
-    out << std::fixed << std::setprecision(1);
-    const std::string style = "fill=\"none\" stroke=\"" + colour + "\" stroke-width=\"2\"";
-    if (shape == "circle") {
-        out << "<circle cx=\"" << x << "\" cy=\"" << y << "\" r=\"" << r << "\" " << style << "/>";
-    } else if (shape == "square") {
-        out << "<rect x=\"" << x - r * 0.85 << "\" y=\"" << y - r * 0.85 << "\" width=\"" << 1.7 * r << "\" height=\""
-            << 1.7 * r << "\" " << style << "/>";
-    } else if (shape == "diamond") {
-        out << "<path d=\"M" << x << "," << y - r * 1.2 << " L" << x + r << "," << y << " L" << x << "," << y + r * 1.2
-            << " L" << x - r << "," << y << " Z\" " << style << "/>";
-    } else if (shape == "triangle_up") {
-        out << "<path d=\"M" << x << "," << y - r * 1.15 << " L" << x + r << "," << y + r * 0.75 << " L" << x - r << ","
-            << y + r * 0.75 << " Z\" " << style << "/>";
-    } else if (shape == "triangle_down") {
-        out << "<path d=\"M" << x << "," << y + r * 1.15 << " L" << x + r << "," << y - r * 0.75 << " L" << x - r << ","
-            << y - r * 0.75 << " Z\" " << style << "/>";
-    } else if (shape == "plus") {
-        out << "<path d=\"M" << x - r << "," << y << " L" << x + r << "," << y << " M" << x << "," << y - r << " L" << x
-            << "," << y + r << "\" " << style << "/>";
-    } else if (shape == "star") {  // an asterisk: the plus and the cross over each other
-        out << "<path d=\"M" << x - r << "," << y << " L" << x + r << "," << y << " M" << x << "," << y - r << " L" << x
-            << "," << y + r << " M" << x - r * 0.7 << "," << y - r * 0.7 << " L" << x + r * 0.7 << "," << y + r * 0.7
-            << " M" << x - r * 0.7 << "," << y + r * 0.7 << " L" << x + r * 0.7 << "," << y - r * 0.7 << "\" " << style
-            << "/>";
-    } else {  // cross
-        out << "<path d=\"M" << x - r << "," << y - r << " L" << x + r << "," << y + r << " M" << x - r << "," << y + r
-            << " L" << x + r << "," << y - r << "\" " << style << "/>";
-    }
-    return out.str();
-}
-
 struct Panel {
     double left, top, width, height;
     std::string y_title;
@@ -397,14 +314,6 @@ struct Panel {
     double (*error)(const Point&);
     bool percent;  // y values are shares, labelled in %
 };
-
-std::string decade_label(int decade, bool percent) {
-    if (percent) {
-        const int p = decade + 2;  // 10^decade as a percentage
-        return p >= 0 ? format_number(std::pow(10.0, p), 6) + "%" : "0." + std::string(std::size_t(-p - 1), '0') + "1%";
-    }
-    return decade >= 0 ? format_number(std::pow(10.0, decade), 6) : "0." + std::string(std::size_t(-decade - 1), '0') + "1";
-}
 
 void write_svg(const fs::path& path, const std::vector<SceneResult>& results, double x_min, double x_max,
                const Options& options, const std::vector<std::string>& subtitle) {
@@ -520,28 +429,6 @@ void write_svg(const fs::path& path, const std::vector<SceneResult>& results, do
 // ---------------------------------------------------------------------------------------------
 // The table (TSV and markdown) and the machine it ran on
 
-std::string cpu_model() {
-    std::ifstream cpuinfo("/proc/cpuinfo");
-    std::string line;
-    while (std::getline(cpuinfo, line))
-        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-    return "unknown";
-}
-
-std::string load_average() {
-    std::ifstream file("/proc/loadavg");
-    double one = 0, five = 0, fifteen = 0;
-    file >> one >> five >> fifteen;
-    return format_number(one, 3) + ", " + format_number(five, 3) + ", " + format_number(fifteen, 3);
-}
-
-std::string utc_now() {
-    const std::time_t now = std::time(nullptr);
-    char text[64];
-    std::strftime(text, sizeof text, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
-    return text;
-}
-
 std::string percent(double share) {
     if (share == 0.0) return "0%";
     std::ostringstream out;
@@ -626,31 +513,9 @@ std::string markdown_section(const std::vector<SceneResult>& results, const Opti
 const std::string begin_marker = "<!-- accuracy_chart:begin (written by tools/chart.sh; edits inside are overwritten) -->";
 const std::string end_marker = "<!-- accuracy_chart:end -->";
 
-// Replaces what lies between the markers, or appends a section with them.
 void update_results(const fs::path& path, const std::string& section) {
-    std::ifstream in(path);
-    if (!in) fail("could not read " + path.string());
-    std::stringstream buffer;
-    buffer << in.rdbuf();
-    std::string text = buffer.str();
-    const std::size_t begin = text.find(begin_marker);
-    const std::size_t end = text.find(end_marker);
-    const std::string marked = begin_marker + "\n\n" + section + "\n" + end_marker;
-    if (begin == std::string::npos || end == std::string::npos || end < begin) {
-        if (begin != std::string::npos || end != std::string::npos)
-            fail(path.string() + ": only one of the accuracy_chart markers is there");
-        if (!text.empty() && text.back() != '\n') text += '\n';
-        text += "\n## Speed against accuracy (tracker issue 3)\n\n" + marked + "\n";
-    } else {
-        text.replace(begin, end + end_marker.size() - begin, marked);
-    }
-    const fs::path temporary = path.string() + ".tmp";
-    {
-        std::ofstream out(temporary);
-        out << text;
-        if (!out) fail("could not write " + temporary.string());
-    }
-    fs::rename(temporary, path);
+    prism::bench::update_marked_section(path, begin_marker, end_marker, "## Speed against accuracy (tracker issue 3)",
+                                        section);
 }
 
 // ---------------------------------------------------------------------------------------------
