@@ -119,9 +119,9 @@ const std::string hw7_inputs = "ceng795/hw7_pathtracing_objlights/2022F_Batucan2
 // another image and the chart would compare bias, not noise.
 const std::vector<ChartScene>& chart_scenes() {
     static const std::vector<ChartScene> list{
-        {"Cornell box with glass and mirror spheres, LightMesh (cornellbox_jaroslav_path_glass)",
+        {"path_glass: glass and mirror spheres, LightMesh box",
          hw7_inputs + "pathTracing/inputs/cornellbox_jaroslav_path_glass.xml"},
-        {"glossy Cornell box (Phong 90-600), small LightMesh (cornellbox_jaroslav_glossy_area_small)",
+        {"glossy_area_small: Phong 90 to 600, small LightMesh box",
          hw7_inputs + "directLighting/inputs/cornellbox_jaroslav_glossy_area_small.xml"},
     };
     return list;
