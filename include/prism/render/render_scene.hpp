@@ -153,6 +153,10 @@ template <Precision P, class Real = typename PrecisionPolicy<P>::Real,
 using ShippedConfigs = ConfigList<Config<Real, Acceleration, PointLightSet, no_features, Whitted>,
                                   Config<Real, Acceleration, AllLightSet, all_features, Whitted>,
                                   Config<Real, Acceleration, AllLightSet, all_features, PathTracer>>;
+#ifdef PRISM_WITH_EMBREE
+// The same through Embree (--accelerator embree), which traverses in float.
+using EmbreeShippedConfigs = ShippedConfigs<Precision::single, float, Embree>;
+#endif
 
 // The image size a camera renders at under RenderOptions::resolution_scale (at least 1 pixel).
 inline int scaled_size(int size, double scale) { return std::max(1, int(std::lround(size * scale))); }
@@ -227,6 +231,24 @@ std::vector<CameraImage> render_first_covering(ConfigList<Configs...>, const sce
     return std::move(*images);
 }
 
+// Programs built with PRISM_SEPARATE_RENDERERS (the project's own examples and tests, through the
+// CMake target prism_shipped_renderers) take each precision's shipped renderers from that
+// target's translation units, one per list (examples/renderers/), instead of compiling all of
+// them in every file that renders a scene: each list costs tens of seconds of compile time, and
+// apart the lists compile once and in parallel. Header-only users need no such target.
+#ifdef PRISM_SEPARATE_RENDERERS
+#define PRISM_SHIPPED_RENDERERS(PREFIX, LIST)                                                            \
+    PREFIX template std::vector<CameraImage> render_first_covering(                                       \
+        LIST, const scene::Needs&, const scene::Scene&, const RenderOptions&, std::ostream&,              \
+        const std::function<void(std::size_t camera, int pixels)>&);
+PRISM_SHIPPED_RENDERERS(extern, ShippedConfigs<Precision::single>)
+PRISM_SHIPPED_RENDERERS(extern, ShippedConfigs<Precision::double_refine>)
+PRISM_SHIPPED_RENDERERS(extern, ShippedConfigs<Precision::double_all>)
+#ifdef PRISM_WITH_EMBREE
+PRISM_SHIPPED_RENDERERS(extern, EmbreeShippedConfigs)
+#endif
+#endif
+
 }  // namespace detail
 
 // Renders every camera. `on_tile(camera, pixels)` reports progress from worker threads.
@@ -271,8 +293,7 @@ inline std::vector<CameraImage> render_scene(
         << offset_reason << ")\n";
 #ifdef PRISM_WITH_EMBREE
     if (embree)
-        return detail::render_first_covering(ShippedConfigs<Precision::single, float, Embree>{}, needs, scene, chosen,
-                                             log, on_tile);
+        return detail::render_first_covering(EmbreeShippedConfigs{}, needs, scene, chosen, log, on_tile);
 #endif
     switch (choice.precision) {
         case Precision::single:
