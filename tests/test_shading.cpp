@@ -370,3 +370,28 @@ TEST_CASE_TEMPLATE("Renderer: camera rays skip a flat back face, as the course d
             check_relative(centre(culling), back_face, 1e-4);
     }
 }
+
+TEST_CASE_TEMPLATE("Renderer: a scene built in code is held to the loaders' limits", Real, float, double) {
+    // The loaders refuse these in files (io/limits.hpp, test_hostile_input.cpp); a program that
+    // builds its scene in code must meet the same wall, with a message, not a crashed stack or a
+    // film too large to allocate.
+    scene::Scene world = lit_scene();
+    using Renderer = prism::Renderer<prism::Config<Real>>;
+    world.max_recursion_depth = prism::io::stack_safe_recursion_depth;
+    CHECK_NOTHROW(Renderer{world});
+    world.max_recursion_depth = prism::io::stack_safe_recursion_depth + 1;
+    CHECK_THROWS_WITH_AS(Renderer{world}, doctest::Contains("MaxRecursionDepth 513"), std::invalid_argument);
+    world.max_recursion_depth = -1;
+    CHECK_THROWS_AS(Renderer{world}, std::invalid_argument);
+
+    world.max_recursion_depth = 1;
+    const Renderer renderer(world);
+    scene::Camera camera = world.cameras.front();
+    CHECK_THROWS_WITH_AS(renderer.render(camera, 40000, 1), doctest::Contains("40000x1"), std::invalid_argument);
+    CHECK_THROWS_WITH_AS(renderer.render(camera, 20000, 20000), doctest::Contains("outside the limits"),
+                         std::invalid_argument);
+    camera.num_samples = int(prism::io::max_samples_per_pixel) + 1;
+    CHECK_THROWS_WITH_AS(renderer.render(camera, 2, 2), doctest::Contains("samples per pixel"), std::invalid_argument);
+    camera.num_samples = 1;
+    CHECK(renderer.render(camera, 2, 2).pixels.size() == 4);
+}

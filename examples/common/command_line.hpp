@@ -63,10 +63,13 @@ public:
             else usage_error("--accelerator must be prism or embree");
             if (options.accelerator == AcceleratorChoice::embree && !embree_available)
                 usage_error("--accelerator embree: this prism was built without Embree 3 (libembree-dev)");
-        } else if (option == "--cull-backfaces") {
-            options.backface_culling = BackfaceCulling::all;
-        } else if (option == "--no-cull-backfaces") {
-            options.backface_culling = BackfaceCulling::none;
+        } else if (option == "--cull-backfaces" || option == "--no-cull-backfaces") {
+            // Both given is a contradiction, not "the last one wins": say so rather than guess.
+            const BackfaceCulling chosen = option == "--cull-backfaces" ? BackfaceCulling::all : BackfaceCulling::none;
+            const BackfaceCulling other = chosen == BackfaceCulling::all ? BackfaceCulling::none : BackfaceCulling::all;
+            if (options.backface_culling == other)
+                usage_error("--cull-backfaces and --no-cull-backfaces contradict each other: give one");
+            options.backface_culling = chosen;
         } else if (option == "--seed") {
             options.seed = number<std::uint64_t>(option, next_value());
         } else {

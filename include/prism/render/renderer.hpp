@@ -9,6 +9,7 @@
 #include <prism/camera/thin_lens_camera.hpp>
 #include <prism/geometry/scene_geometry.hpp>
 #include <prism/image/image.hpp>
+#include <prism/io/limits.hpp>
 #include <prism/light/environment_light.hpp>
 #include <prism/render/config.hpp>
 #include <prism/texture/texture_set.hpp>
@@ -66,6 +67,7 @@ public:
     Image render(const scene::Camera& camera, int width = 0, int height = 0, OnTile on_tile = [](int) {}) const {
         if (width <= 0) width = camera.width;
         if (height <= 0) height = camera.height;
+        check_image(camera, width, height);
         const ThinLensCamera<Real> lens(camera, width, height);
         const int count = std::max(1, camera.num_samples);
         Image image(width, height);
@@ -112,9 +114,35 @@ private:
         return glm::vec3(sum / weights);
     }
 
+    // A scene built in code meets the limits the loaders hold files to (io/limits.hpp): the ray
+    // tracer recurses once per bounce on a worker's stack, so a depth beyond the stack-safe one
+    // would crash, not fail.
+    static void check_limits(const scene::Scene& scene) {
+        if (scene.max_recursion_depth < 0 || scene.max_recursion_depth > io::stack_safe_recursion_depth)
+            throw std::invalid_argument("MaxRecursionDepth " + std::to_string(scene.max_recursion_depth) +
+                                        " is outside [0, " + std::to_string(io::stack_safe_recursion_depth) +
+                                        "], the depth the renderer's stack is known to hold");
+    }
+
+    // An image the film could not hold, or a sample count past the loaders' limit, is refused
+    // before anything is allocated for it.
+    static void check_image(const scene::Camera& camera, int width, int height) {
+        const std::string name = "camera " + camera.id + ": ";
+        if (width < 1 || height < 1 || width > io::max_image_side || height > io::max_image_side ||
+            std::int64_t(width) * std::int64_t(height) > io::max_image_pixels)
+            throw std::invalid_argument(name + "an image of " + std::to_string(width) + "x" + std::to_string(height) +
+                                        " pixels is outside the limits (" + std::to_string(io::max_image_side) +
+                                        " a side, " + std::to_string(io::max_image_pixels) + " in all)");
+        if (camera.num_samples > io::max_samples_per_pixel)
+            throw std::invalid_argument(name + std::to_string(camera.num_samples) +
+                                        " samples per pixel are more than the limit of " +
+                                        std::to_string(io::max_samples_per_pixel));
+    }
+
     // A renderer compiled without a light kind, a feature or an integrator the scene needs
     // refuses the scene, rather than rendering it wrong.
     static const scene::Scene& check_features(const scene::Scene& scene) {
+        check_limits(scene);
         const scene::Needs needs = scene::measure_needs(scene);
         if (!C::covers(needs)) {
             std::string missing = needs.beyond(C::meets);
