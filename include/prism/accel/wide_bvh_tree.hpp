@@ -172,6 +172,23 @@ private:
                     found = true;
                     if constexpr (AnyHit) return true;
                 }
+            } else if (const std::uint32_t rest = hits & (hits - 1); hits != 0 && (rest & (rest - 1)) == 0) {
+                // Two children entered: one comparison orders them. The nearer is descended at
+                // once, or pushed last if it is a leaf; on a tie the second child goes first,
+                // as the insertion sort below orders it (which triangle wins a tie depends on
+                // the order).
+                entry_distances.store(distances);
+                const int first = std::countr_zero(hits), second = std::countr_zero(rest);
+                int near = second, far = first;
+                if constexpr (!AnyHit) {
+                    if (distances[first] < distances[second]) std::swap(near, far);
+                }
+                stack[size++] = StackEntry{node.child[far], node.count[far], distances[far]};
+                if (node.count[near] == 0) {
+                    current = node.child[near];
+                    continue;
+                }
+                stack[size++] = StackEntry{node.child[near], node.count[near], distances[near]};
             } else if (hits != 0) {
                 entry_distances.store(distances);
                 // Push the entered children farthest first, so the nearest is popped next: an
