@@ -27,6 +27,8 @@
 #include <tbb/global_control.h>
 
 #ifdef PRISM_BENCH_WITH_EMBREE
+#include <prism/accel/embree.hpp>
+
 #include <embree3/rtcore.h>
 #endif
 
@@ -339,20 +341,8 @@ RTCScene build_embree_scene(const scene::Scene& scene, bool robust) {
     RTCScene embree_scene = rtcNewScene(device);
     rtcSetSceneFlags(embree_scene, robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
     for (const scene::Mesh& mesh : scene.meshes) {
-        RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-            geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.positions.size()));
-        for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
-            const glm::vec3 p(glm::dvec3(mesh.transform * glm::dvec4(mesh.positions[v], 1.0)));
-            vertices[3 * v + 0] = p.x;
-            vertices[3 * v + 1] = p.y;
-            vertices[3 * v + 2] = p.z;
-        }
-        auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-            geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), mesh.triangles.size()));
-        for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
-            for (int k = 0; k < 3; ++k) indices[3 * t + k] = mesh.triangles[t][k];
-        rtcCommitGeometry(geometry);
+        // Placed in world space: Embree's scene is one BVH over every triangle, no instances.
+        RTCGeometry geometry = prism::embree_triangle_geometry(device, mesh, mesh.transform);
         rtcAttachGeometry(embree_scene, geometry);
         rtcReleaseGeometry(geometry);
     }

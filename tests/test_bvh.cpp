@@ -971,3 +971,89 @@ TEST_CASE_TEMPLATE("Wide BVH structure (4 and 8 children): a mesh, one centroid,
     check_wide_trees<Real, 4>();
     check_wide_trees<Real, 8>();
 }
+
+namespace {
+
+// The leaves a traversal visits, in order, with the t_max each saw: a leaf "hits" at 0.9 of
+// its t_max every third call, so the sequence also depends on how t_max prunes the rest.
+template <class Real>
+struct LeafLog {
+    std::vector<std::array<double, 3>> visits;  // first, count, t_max on entry
+    int calls = 0;
+    auto closest() {
+        return [this](std::uint32_t first, std::uint32_t count, Real& t_max) {
+            visits.push_back({double(first), double(count), double(t_max)});
+            if (++calls % 3 != 0) return false;
+            t_max = std::isinf(t_max) ? Real(50) : Real(0.9) * t_max;
+            return true;
+        };
+    }
+};
+
+// A ray prepared once (Index::TraversalRay, what SceneGeometry shares between the top level and
+// the meshes in world space) must traverse exactly as the ray itself.
+template <class Index, class Real>
+void check_prepared_traversal(const std::vector<prism::Aabb<Real>>& boxes, const std::vector<prism::Ray<Real>>& rays) {
+    const Index index = Index::build(boxes);
+    std::size_t closest_differ = 0, any_differ = 0;
+    for (const prism::Ray<Real>& ray : rays) {
+        LeafLog<Real> own, shared;
+        Real t_own = ray.t_max, t_shared = ray.t_max;
+        index.traverse_closest(ray, t_own, own.closest());
+        const typename Index::TraversalRay prepared(ray);
+        index.traverse_closest(prepared, ray.t_min, t_shared, shared.closest());
+        closest_differ += own.visits != shared.visits || t_own != t_shared;
+        const auto any = [](std::uint32_t first, std::uint32_t, Real&) { return first % 2 == 1; };
+        any_differ += index.traverse_any(ray, ray.t_max, any) != index.traverse_any(prepared, ray.t_min, ray.t_max, any);
+    }
+    CHECK(closest_differ == 0);
+    CHECK(any_differ == 0);
+}
+
+}  // namespace
+
+TEST_CASE_TEMPLATE("Indices: a ray prepared once traverses exactly as the ray itself", Real, float, double) {
+    std::vector<glm::dvec3> positions;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    perturbed_sphere(3, 17, positions, triangles);
+    const auto boxes = triangle_boxes<Real>(positions, triangles);
+    const auto rays = test_rays<Real>(bounds_of(positions), positions, 2000, 41);
+    check_prepared_traversal<prism::BvhTree<Real>>(boxes, rays);
+    check_prepared_traversal<prism::WideBvhTree<Real, 4>>(boxes, rays);
+    check_prepared_traversal<prism::WideBvhTree<Real, 8>>(boxes, rays);
+    check_prepared_traversal<prism::PrimitiveList<Real>>(boxes, rays);
+}
+
+TEST_CASE_TEMPLATE("TriangleMesh: the caller's shared ray set-up finds the hits of the mesh's own", Real, float, double) {
+    std::vector<glm::dvec3> positions;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    perturbed_sphere(3, 23, positions, triangles);
+    const scene::Mesh mesh = soup_with_triangle_ids(positions, triangles);
+    const auto rays = test_rays<Real>(bounds_of(positions), positions, 5000, 7);
+    const auto check = [&]<class Policy>() {
+        const prism::TriangleMesh<Real, Policy> triangle_mesh(mesh);
+        using Mesh = prism::TriangleMesh<Real, Policy>;
+        std::size_t hits = 0, differ = 0;
+        for (const prism::Ray<Real>& ray : rays) {
+            prism::Hit<Real> own_hit, shared_hit;
+            Real t_own = ray.t_max, t_shared = ray.t_max;
+            const typename Mesh::TraversalRay traversal_ray(ray);
+            const typename Mesh::TriangleRay triangle_ray(ray);
+            const bool own = triangle_mesh.template intersect<false>(ray, t_own, own_hit);
+            const bool shared = triangle_mesh.template intersect<false>(ray, traversal_ray, triangle_ray, t_shared, shared_hit);
+            hits += own;
+            differ += own != shared || t_own != t_shared ||
+                      (own && (own_hit.primitive != shared_hit.primitive || own_hit.b1 != shared_hit.b1 ||
+                               own_hit.b2 != shared_hit.b2));
+            differ += triangle_mesh.occluded(ray, ray.t_max) !=
+                      triangle_mesh.occluded(ray, traversal_ray, triangle_ray, ray.t_max);
+        }
+        CHECK(hits > rays.size() / 2);
+        CHECK(differ == 0);
+    };
+    check.template operator()<prism::Bvh<prism::Watertight>>();
+    check.template operator()<prism::WideBvh<prism::Watertight, 4>>();
+    check.template operator()<prism::WideBvh<prism::Watertight, 8>>();
+    check.template operator()<prism::WideBvh<prism::DoubleRefine, 8>>();
+    check.template operator()<prism::BruteForce<prism::Watertight>>();
+}

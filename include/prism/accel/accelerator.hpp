@@ -21,6 +21,7 @@ template <class I, class Real>
 concept SpatialIndex = Scalar<Real> && requires(const I& index, std::span<const Aabb<Real>> boxes,
                                                 const Ray<Real>& ray, Real t) {
     { I::build(boxes) } -> std::same_as<I>;
+    typename I::TraversalRay;  // what traversal prepares of a ray, once (two levels can share it)
     { index.primitive_indices() };
     { index.traverse_any(ray, t, [](std::uint32_t, std::uint32_t, Real&) { return true; }) } -> std::same_as<bool>;
 };

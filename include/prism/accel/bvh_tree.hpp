@@ -75,13 +75,24 @@ public:
     // lowering t_max on hits. Children are visited nearest first so t_max prunes early.
     template <class Leaf>
     void traverse_closest(const Ray<Real>& ray, Real& t_max, Leaf&& leaf) const {
-        traverse<false>(ray, t_max, leaf);
+        traverse<false>(TraversalRay(ray), ray.t_min, t_max, leaf);
     }
 
     // Any hit: stops as soon as `leaf(first, count, t_max)` returns true.
     template <class Leaf>
     bool traverse_any(const Ray<Real>& ray, Real t_max, Leaf&& leaf) const {
-        return traverse<true>(ray, t_max, leaf);
+        return traverse<true>(TraversalRay(ray), ray.t_min, t_max, leaf);
+    }
+
+    // The same from a ray prepared once (shared by both levels of a scene, as in WideBvhTree).
+    using TraversalRay = RayBoxPrecomputed<Real>;
+    template <class Leaf>
+    void traverse_closest(const TraversalRay& ray, Real t_min, Real& t_max, Leaf&& leaf) const {
+        traverse<false>(ray, t_min, t_max, leaf);
+    }
+    template <class Leaf>
+    bool traverse_any(const TraversalRay& ray, Real t_min, Real t_max, Leaf&& leaf) const {
+        return traverse<true>(ray, t_min, t_max, leaf);
     }
 
 private:
@@ -94,10 +105,9 @@ private:
     }
 
     template <bool AnyHit, class Leaf>
-    bool traverse(const Ray<Real>& ray, Real& t_max, Leaf& leaf) const {
+    bool traverse(const TraversalRay& box_ray, Real t_min, Real& t_max, Leaf& leaf) const {
         if (nodes_.empty()) return false;
-        const RayBoxPrecomputed<Real> box_ray(ray);
-        if (enter(nodes_[0], box_ray, ray.t_min, t_max) == infinity<Real>) return false;
+        if (enter(nodes_[0], box_ray, t_min, t_max) == infinity<Real>) return false;
         std::array<std::uint32_t, max_depth> stack;
         int stack_size = 0;
         std::uint32_t current = 0;
@@ -111,8 +121,8 @@ private:
                 }
             } else {
                 const std::uint32_t left = node.index, right = node.index + 1;
-                const Real t_left = enter(nodes_[left], box_ray, ray.t_min, t_max);
-                const Real t_right = enter(nodes_[right], box_ray, ray.t_min, t_max);
+                const Real t_left = enter(nodes_[left], box_ray, t_min, t_max);
+                const Real t_right = enter(nodes_[right], box_ray, t_min, t_max);
                 const bool hit_left = t_left != infinity<Real>, hit_right = t_right != infinity<Real>;
                 if (hit_left && hit_right) {
                     const bool left_first = t_left <= t_right;

@@ -33,6 +33,29 @@ namespace prism {
 
 template <Scalar Real, bool MotionBlur> class EmbreeGeometry;
 
+// A mesh as a committed Embree triangle geometry of `device`, its vertices placed by `to_world`
+// (computed in double) and rounded once to float, as prism's float meshes round them. The one
+// place prism fills Embree's buffers: EmbreeGeometry and bench/intersect_bench.cpp use it.
+inline RTCGeometry embree_triangle_geometry(RTCDevice device, const scene::Mesh& mesh,
+                                            const glm::dmat4& to_world = glm::dmat4(1.0)) {
+    RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+        geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.positions.size()));
+    const bool placed = to_world != glm::dmat4(1.0);
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+        const glm::vec3 p(placed ? glm::dvec3(to_world * glm::dvec4(mesh.positions[v], 1.0)) : mesh.positions[v]);
+        vertices[3 * v + 0] = p.x;
+        vertices[3 * v + 1] = p.y;
+        vertices[3 * v + 2] = p.z;
+    }
+    auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+        geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), mesh.triangles.size()));
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+        for (int k = 0; k < 3; ++k) indices[3 * t + k] = mesh.triangles[t][k];
+    rtcCommitGeometry(geometry);
+    return geometry;
+}
+
 // The policy. Intersector and Index name how the shapes are stored for prism's own per-primitive
 // test (AccelerationPolicy); Geometry is what the renderer builds instead of SceneGeometry.
 struct Embree {
@@ -206,7 +229,7 @@ private:
         std::unique_ptr<SceneHandle>& cached = mesh_scenes_[mesh_index];
         if (cached) return cached->get();
         cached = std::make_unique<SceneHandle>(rtcNewScene(device_.get()));
-        RTCGeometry geometry = triangle_geometry(scene.meshes[mesh_index]);
+        RTCGeometry geometry = embree_triangle_geometry(device_.get(), scene.meshes[mesh_index]);
         rtcAttachGeometryByID(cached->get(), geometry, 0);
         rtcReleaseGeometry(geometry);
         rtcSetSceneFlags(cached->get(), RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
@@ -215,23 +238,6 @@ private:
         return cached->get();
     }
 
-    RTCGeometry triangle_geometry(const scene::Mesh& mesh) {
-        RTCGeometry geometry = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
-        auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-            geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.positions.size()));
-        for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
-            const glm::vec3 p(mesh.positions[v]);  // rounded once, as prism's float meshes are
-            vertices[3 * v + 0] = p.x;
-            vertices[3 * v + 1] = p.y;
-            vertices[3 * v + 2] = p.z;
-        }
-        auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-            geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), mesh.triangles.size()));
-        for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
-            for (int k = 0; k < 3; ++k) indices[3 * t + k] = mesh.triangles[t][k];
-        rtcCommitGeometry(geometry);
-        return geometry;
-    }
 
     // A mesh placed by `transform` (and moving by `motion` over the shutter): its triangles go
     // straight into the top scene when it is not moved at all, else an instance of its scene.
@@ -240,7 +246,7 @@ private:
         const bool moving = MotionBlur && motion != glm::dvec3(0.0);
         RTCGeometry geometry;
         if (transform == glm::dmat4(1.0) && !moving) {
-            geometry = triangle_geometry(scene.meshes[mesh_index]);
+            geometry = embree_triangle_geometry(device_.get(), scene.meshes[mesh_index]);
         } else {
             geometry = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_INSTANCE);
             rtcSetGeometryInstancedScene(geometry, mesh_scene(scene, mesh_index));

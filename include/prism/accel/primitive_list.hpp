@@ -35,6 +35,19 @@ public:
         return !primitive_indices_.empty() && leaf(0u, std::uint32_t(primitive_indices_.size()), t_max);
     }
 
+    // Nothing to prepare of a ray; the overloads keep the interface of the trees.
+    struct TraversalRay {
+        explicit TraversalRay(const Ray<Real>&) {}
+    };
+    template <class Leaf>
+    void traverse_closest(const TraversalRay&, Real, Real& t_max, Leaf&& leaf) const {
+        if (!primitive_indices_.empty()) leaf(0u, std::uint32_t(primitive_indices_.size()), t_max);
+    }
+    template <class Leaf>
+    bool traverse_any(const TraversalRay&, Real, Real t_max, Leaf&& leaf) const {
+        return !primitive_indices_.empty() && leaf(0u, std::uint32_t(primitive_indices_.size()), t_max);
+    }
+
 private:
     std::vector<std::uint32_t> primitive_indices_;
     Aabb<Real> bounds_;

@@ -76,26 +76,19 @@ public:
         return nodes_.capacity() * sizeof(WideBvhNode<Real, N>) + primitive_indices_.capacity() * sizeof(std::uint32_t);
     }
 
-    template <class Leaf>
-    void traverse_closest(const Ray<Real>& ray, Real& t_max, Leaf&& leaf) const {
-        traverse<false>(ray, t_max, leaf);
-    }
-
-    template <class Leaf>
-    bool traverse_any(const Ray<Real>& ray, Real t_max, Leaf&& leaf) const {
-        return traverse<true>(ray, t_max, leaf);
-    }
-
 private:
     using Pack = simd::Pack<Real, N>;
     // Ize's conservative far distance, as in BvhTree: every exit distance times 1 + 2 gamma(3).
     static constexpr Real far_scale = Real(1) + 2 * gamma<Real>(3);
 
-    struct RaySlabs {
+public:
+    // What the slab test needs of a ray, broadcast once. A two-level scene whose mesh shares
+    // the world's space prepares it once per ray for both levels (geometry/scene_geometry.hpp).
+    struct TraversalRay {
         Pack origin[3], inverse_direction[3];
         int near_plane[3], far_plane[3];  // rows of WideBvhNode::bounds, by the direction's sign
 
-        explicit RaySlabs(const Ray<Real>& ray) {
+        explicit TraversalRay(const Ray<Real>& ray) {
             const RayBoxPrecomputed<Real> box_ray(ray);
             for (int axis = 0; axis < 3; ++axis) {
                 origin[axis] = Pack::broadcast(box_ray.origin[axis]);
@@ -109,10 +102,30 @@ private:
         }
     };
 
+    template <class Leaf>
+    void traverse_closest(const Ray<Real>& ray, Real& t_max, Leaf&& leaf) const {
+        traverse<false>(TraversalRay(ray), ray.t_min, t_max, leaf);
+    }
+    template <class Leaf>
+    void traverse_closest(const TraversalRay& ray, Real t_min, Real& t_max, Leaf&& leaf) const {
+        traverse<false>(ray, t_min, t_max, leaf);
+    }
+
+    template <class Leaf>
+    bool traverse_any(const Ray<Real>& ray, Real t_max, Leaf&& leaf) const {
+        return traverse<true>(TraversalRay(ray), ray.t_min, t_max, leaf);
+    }
+    template <class Leaf>
+    bool traverse_any(const TraversalRay& ray, Real t_min, Real t_max, Leaf&& leaf) const {
+        return traverse<true>(ray, t_min, t_max, leaf);
+    }
+
+private:
+
     // Every child's entry distance; the mask says which children the ray enters within
     // [t_min, t_max]. A NaN distance (0 * inf, a ray in a slab's plane) constrains nothing,
     // as in the scalar intersect_box.
-    [[gnu::always_inline]] static simd::Mask<Real, N> enter(const WideBvhNode<Real, N>& node, const RaySlabs& ray, Real t_min, Real t_max,
+    [[gnu::always_inline]] static simd::Mask<Real, N> enter(const WideBvhNode<Real, N>& node, const TraversalRay& ray, Real t_min, Real t_max,
                                      Pack& entry) {
         const Pack scale = Pack::broadcast(far_scale);
         Pack t_enter = Pack::broadcast(t_min);
@@ -136,9 +149,8 @@ private:
     };
 
     template <bool AnyHit, class Leaf>
-    bool traverse(const Ray<Real>& ray, Real& t_max, Leaf& leaf) const {
+    bool traverse(const TraversalRay& slabs, Real t_min, Real& t_max, Leaf& leaf) const {
         if (nodes_.empty()) return false;
-        const RaySlabs slabs(ray);
         std::array<StackEntry, stack_size> stack;
         int size = 0;
         bool found = false;
@@ -147,7 +159,7 @@ private:
         for (;;) {
             const WideBvhNode<Real, N>& node = nodes_[current];
             Pack entry_distances;
-            std::uint32_t hits = enter(node, slabs, ray.t_min, t_max, entry_distances).bits();
+            std::uint32_t hits = enter(node, slabs, t_min, t_max, entry_distances).bits();
             bool descend = false;
             if (hits != 0 && (hits & (hits - 1)) == 0) {
                 // One child entered, the common case deep in the tree: no stack, no sort.
@@ -160,6 +172,23 @@ private:
                     found = true;
                     if constexpr (AnyHit) return true;
                 }
+            } else if (const std::uint32_t rest = hits & (hits - 1); hits != 0 && (rest & (rest - 1)) == 0) {
+                // Two children entered: one comparison orders them. The nearer is descended at
+                // once, or pushed last if it is a leaf; on a tie the second child goes first,
+                // as the insertion sort below orders it (which triangle wins a tie depends on
+                // the order).
+                entry_distances.store(distances);
+                const int first = std::countr_zero(hits), second = std::countr_zero(rest);
+                int near = second, far = first;
+                if constexpr (!AnyHit) {
+                    if (distances[first] < distances[second]) std::swap(near, far);
+                }
+                stack[size++] = StackEntry{node.child[far], node.count[far], distances[far]};
+                if (node.count[near] == 0) {
+                    current = node.child[near];
+                    continue;
+                }
+                stack[size++] = StackEntry{node.child[near], node.count[near], distances[near]};
             } else if (hits != 0) {
                 entry_distances.store(distances);
                 // Push the entered children farthest first, so the nearest is popped next: an

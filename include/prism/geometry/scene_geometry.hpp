@@ -18,6 +18,7 @@
 #include <prism/scene/scene.hpp>
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 namespace prism {
@@ -115,11 +116,13 @@ public:
     bool intersect(Ray<Real>& ray, Hit<Real>& hit) const {
         bool found = false;
         const auto& order = top_.primitive_indices();
-        top_.traverse_closest(ray, ray.t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_max) {
+        const TraversalRay traversal_ray(ray);
+        std::optional<TriangleRay> world_triangle_ray;  // made when the ray first enters a mesh
+        top_.traverse_closest(traversal_ray, ray.t_min, ray.t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_max) {
             bool leaf_hit = false;
             for (std::uint32_t i = first; i < first + count; ++i) {
                 const std::uint32_t object = order[i];
-                if (intersect_instance<Culling>(instances_[object], ray, t_max, hit)) {
+                if (intersect_instance<Culling>(instances_[object], ray, traversal_ray, world_triangle_ray, t_max, hit)) {
                     hit.object = object;
                     leaf_hit = true;
                 }
@@ -152,10 +155,12 @@ public:
     // Whether anything lies in (ray.t_min, ray.t_max).
     bool occluded(const Ray<Real>& ray) const {
         const auto& order = top_.primitive_indices();
+        const TraversalRay traversal_ray(ray);
+        std::optional<TriangleRay> world_triangle_ray;
         const bool blocked =
-            top_.traverse_any(ray, ray.t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_max) {
+            top_.traverse_any(traversal_ray, ray.t_min, ray.t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_max) {
                 for (std::uint32_t i = first; i < first + count; ++i)
-                    if (occludes(instances_[order[i]], ray, t_max)) return true;
+                    if (occludes(instances_[order[i]], ray, traversal_ray, world_triangle_ray, t_max)) return true;
                 return false;
             });
         return blocked || occluded_by_planes(ray);
@@ -291,6 +296,10 @@ public:
 
 private:
     enum class Kind : std::uint8_t { mesh, sphere };
+    using Mesh = TriangleMesh<Real, Policy>;
+    // The top level and every mesh share one index type, so one prepared ray serves both.
+    using TraversalRay = typename Index::TraversalRay;
+    using TriangleRay = typename Mesh::TriangleRay;
 
     struct Instance {
         Kind kind = Kind::mesh;
@@ -379,14 +388,30 @@ private:
         return instance.transformed ? instance.to_object(ray) : ray;
     }
 
+    // Whether the instance's object space is the world's at every instant: then its mesh
+    // reuses the world ray's set-up (the same ray, bit for bit) instead of preparing its own.
+    static bool in_world_space(const Instance& instance) {
+        if constexpr (MotionBlur) {
+            if (instance.moving) return false;
+        }
+        return !instance.transformed;
+    }
+
     template <BackfaceCulling Culling>
-    bool intersect_instance(const Instance& instance, const Ray<Real>& ray, Real& t_max, Hit<Real>& hit) const {
-        const Ray<Real> local = to_object(instance, ray);
+    bool intersect_instance(const Instance& instance, const Ray<Real>& ray, const TraversalRay& traversal_ray,
+                            std::optional<TriangleRay>& world_triangle_ray, Real& t_max, Hit<Real>& hit) const {
         if (instance.kind == Kind::mesh) {
             const auto& mesh = meshes_[instance.shape];
             const bool cull = Culling == BackfaceCulling::all || (Culling == BackfaceCulling::flat_triangles && !mesh.smooth());
+            if (in_world_space(instance)) {
+                if (!world_triangle_ray) world_triangle_ray.emplace(ray);
+                return cull ? mesh.template intersect<true>(ray, traversal_ray, *world_triangle_ray, t_max, hit)
+                            : mesh.template intersect<false>(ray, traversal_ray, *world_triangle_ray, t_max, hit);
+            }
+            const Ray<Real> local = to_object(instance, ray);
             return cull ? mesh.template intersect<true>(local, t_max, hit) : mesh.template intersect<false>(local, t_max, hit);
         }
+        const Ray<Real> local = to_object(instance, ray);
         Real t;
         if (!spheres_[instance.shape].intersect(local, ray.t_min, t_max, t)) return false;
         t_max = t;
@@ -395,7 +420,12 @@ private:
         return true;
     }
 
-    bool occludes(const Instance& instance, const Ray<Real>& ray, Real t_max) const {
+    bool occludes(const Instance& instance, const Ray<Real>& ray, const TraversalRay& traversal_ray,
+                  std::optional<TriangleRay>& world_triangle_ray, Real t_max) const {
+        if (instance.kind == Kind::mesh && in_world_space(instance)) {
+            if (!world_triangle_ray) world_triangle_ray.emplace(ray);
+            return meshes_[instance.shape].occluded(ray, traversal_ray, *world_triangle_ray, t_max);
+        }
         const Ray<Real> local = to_object(instance, ray);
         if (instance.kind == Kind::mesh) return meshes_[instance.shape].occluded(local, t_max);
         Real t;

@@ -73,15 +73,32 @@ public:
         return bytes;
     }
 
+    using TraversalRay = typename Index::TraversalRay;
+    // What the triangle tests need of a ray, computed once per ray: the watertight shear, and
+    // its broadcast into packets under a wide BVH.
+    struct TriangleRay {
+        Prepared prepared;
+        typename Packets::PackedRay packed_ray;
+        explicit TriangleRay(const Ray<Real>& ray) : prepared(ray), packed_ray(prepared) {}
+    };
+
     // Closest hit along `ray` (object space) below t_max; lowers t_max and fills t, primitive,
     // barycentrics. Culling skips triangles whose winding faces away from the ray.
     template <bool CullBackfaces>
     bool intersect(const Ray<Real>& ray, Real& t_max, Hit<Real>& hit) const {
-        const Prepared prepared(ray);
+        return intersect<CullBackfaces>(ray, TraversalRay(ray), TriangleRay(ray), t_max, hit);
+    }
+
+    // The same with the ray's traversal and triangle set-up made by the caller, who may share
+    // them between meshes in one space (SceneGeometry, for meshes in world space).
+    template <bool CullBackfaces>
+    bool intersect(const Ray<Real>& ray, const TraversalRay& traversal_ray, const TriangleRay& triangle_ray, Real& t_max,
+                   Hit<Real>& hit) const {
+        const Prepared& prepared = triangle_ray.prepared;
         if constexpr (packed) {
-            const typename Packets::PackedRay packed_ray(prepared);
+            const typename Packets::PackedRay& packed_ray = triangle_ray.packed_ray;
             bool found = false;
-            index_.traverse_closest(ray, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
+            index_.traverse_closest(traversal_ray, ray.t_min, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
                 const bool leaf_hit = packets_.template intersect<CullBackfaces>(packed_ray, ray.direction, first,
                                                                                  count, ray.t_min, t_limit, hit);
                 found |= leaf_hit;
@@ -90,7 +107,7 @@ public:
             return found;
         }
         bool found = false;
-        index_.traverse_closest(ray, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
+        index_.traverse_closest(traversal_ray, ray.t_min, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
             bool leaf_hit = false;
             for (std::uint32_t slot = first; slot < first + count; ++slot) {
                 const auto& p = triangles_[slot];
@@ -134,14 +151,19 @@ public:
     }
 
     bool occluded(const Ray<Real>& ray, Real t_max) const {
-        const Prepared prepared(ray);
+        return occluded(ray, TraversalRay(ray), TriangleRay(ray), t_max);
+    }
+
+    // The same with the ray's set-up made by the caller, as for intersect.
+    bool occluded(const Ray<Real>& ray, const TraversalRay& traversal_ray, const TriangleRay& triangle_ray, Real t_max) const {
+        const Prepared& prepared = triangle_ray.prepared;
         if constexpr (packed) {
-            const typename Packets::PackedRay packed_ray(prepared);
-            return index_.traverse_any(ray, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
+            const typename Packets::PackedRay& packed_ray = triangle_ray.packed_ray;
+            return index_.traverse_any(traversal_ray, ray.t_min, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
                 return packets_.occluded(packed_ray, first, count, ray.t_min, t_limit);
             });
         }
-        return index_.traverse_any(ray, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
+        return index_.traverse_any(traversal_ray, ray.t_min, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
             for (std::uint32_t slot = first; slot < first + count; ++slot) {
                 const auto& p = triangles_[slot];
                 TriangleHit<Real> triangle_hit;

@@ -198,7 +198,12 @@ private:
 
 // The packets a policy's meshes keep: none for the binary BVH, brute force or a scalar-only
 // intersector; TrianglePackets for a wide BVH (a policy with a packet_width) of a packed test.
-struct NoTrianglePackets {};
+struct NoTrianglePackets {
+    struct PackedRay {
+        template <class Prepared>
+        explicit PackedRay(const Prepared&) {}
+    };
+};
 
 template <class Policy, class Real, bool = requires { Policy::packet_width; } &&
                                           PacketIntersector<typename Policy::Intersector>>

@@ -126,21 +126,30 @@ using AllLightSet = Lights<PointLight, DirectionalLight, SpotLight, AreaLight, E
 inline constexpr Features no_features{};
 inline constexpr Features all_features{.textures = true, .motion_blur = true};
 
-// What each precision builds: its scalar type and its acceleration policy. The 8-wide BVH beat
-// the 4-wide one on every batch but one of bench/intersect_bench.cpp (AVX2 build: 0.72-0.85 of
-// its time in float, 0.69-0.98 in double; bench/RESULTS.md), and the binary BVH by 1.6-2.1x.
+// The wide BVH's width for the instruction set the renderer is compiled for. With AVX a node's
+// 8 boxes are one register of floats, and the 8-wide BVH beat the 4-wide one on every batch of
+// bench/intersect_bench.cpp (0.72-0.85 of its time in float, 0.69-0.98 in double). Without it
+// (x86-64's SSE2 baseline, ARM's NEON) 8 floats take two registers: the 8-wide tree then took
+// 1.3-2.1x the 4-wide one's time in float, and was slower than the binary BVH (bench/RESULTS.md).
+#ifdef __AVX__
+inline constexpr int wide_bvh_width = 8;
+#else
+inline constexpr int wide_bvh_width = 4;
+#endif
+
+// What each precision builds: its scalar type and its acceleration policy.
 template <Precision P> struct PrecisionPolicy;
 template <> struct PrecisionPolicy<Precision::single> {
     using Real = float;
-    using Acceleration = WideBvh<Watertight, 8>;
+    using Acceleration = WideBvh<Watertight, wide_bvh_width>;
 };
 template <> struct PrecisionPolicy<Precision::double_refine> {
     using Real = float;
-    using Acceleration = WideBvh<DoubleRefine, 8>;
+    using Acceleration = WideBvh<DoubleRefine, wide_bvh_width>;
 };
 template <> struct PrecisionPolicy<Precision::double_all> {
     using Real = double;
-    using Acceleration = WideBvh<Watertight, 8>;
+    using Acceleration = WideBvh<Watertight, wide_bvh_width>;
 };
 
 template <class... Configs> struct ConfigList {};
