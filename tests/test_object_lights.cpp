@@ -322,3 +322,30 @@ TEST_CASE_TEMPLATE("ray tracer: object lights light the surfaces they face (thei
         CHECK(double(image(0, 0).g) == doctest::Approx(pi * 3.0 * (0.25 / 2) * (0.25 / 2)).epsilon(0.02));
     }
 }
+
+TEST_CASE_TEMPLATE("path tracer: a mirror keeps its BRDF terms, as the ray tracer shades it", Real, float, double) {
+    // The floor above, now a mirror (MirrorReflectance 0.5) with diffuse 1: the ray tracer gives
+    // the diffuse term of the LightMesh's light plus the mirrored light (radiance 2 times 0.5);
+    // the path tracer must estimate the same, with and without multiple importance sampling.
+    using Path = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::AllLightSet, prism::all_features,
+                               prism::PathTracer>;
+    scene::Mesh square;
+    square.material = 1;
+    square.positions = {{-0.5, 1, -0.5}, {0.5, 1, -0.5}, {0.5, 1, 0.5}, {-0.5, 1, 0.5}};
+    square.triangles = {{0, 1, 2}, {0, 2, 3}};
+    square.radiance = {2, 2, 2};
+    scene::Scene world = floor_under(&square, nullptr);
+    world.max_recursion_depth = 1;
+    world.materials[0].type = scene::MaterialType::mirror;
+    world.materials[0].mirror = {0.5, 0.5, 0.5};
+    const prism::Renderer<Path> renderer(world);
+    const double traced = double(renderer.render(world.cameras[0])(0, 0).g);
+    const double x = 0.5, root = std::sqrt(1 + x * x);
+    CHECK(traced == doctest::Approx(1.0 + pi * 2.0 * 4 * (x / root * std::atan(x / root)) / pi).epsilon(0.02));
+    for (const bool mis : {false, true}) {
+        CAPTURE(mis);
+        scene::Camera camera = world.cameras[0];
+        camera.renderer = {true, true, true, false, mis};
+        CHECK(double(renderer.render(camera)(0, 0).g) == doctest::Approx(traced).epsilon(0.03));
+    }
+}
