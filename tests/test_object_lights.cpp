@@ -257,3 +257,95 @@ TEST_CASE_TEMPLATE("Renderer: rays see object lights' radiance, transformed and 
     REQUIRE(renderer.lights().template of_type<prism::LightMesh>()->size() == 2);
     REQUIRE(renderer.lights().template of_type<prism::LightSphere>()->size() == 1);
 }
+
+namespace {
+
+// A floor (y = 0, diffuse 1, no BRDF: the course's kd cos E) under one object light, seen by a
+// ray-traced camera at y = 0.5 looking straight down through a tiny near plane: its one pixel
+// is the floor's radiance at the origin, kd times the irradiance there.
+scene::Scene floor_under(const scene::Mesh* light_mesh, const scene::Sphere* light_sphere) {
+    scene::Scene world;
+    scene::Material floor_material;
+    floor_material.diffuse = {1, 1, 1};
+    world.materials.push_back(floor_material);
+    world.materials.push_back(scene::Material{});  // the light's: black
+    scene::Mesh floor;
+    floor.positions = {{-10, 0, -10}, {10, 0, -10}, {10, 0, 10}, {-10, 0, 10}};
+    floor.triangles = {{0, 2, 1}, {0, 3, 2}};
+    world.meshes.push_back(floor);
+    if (light_mesh) world.meshes.push_back(*light_mesh);
+    if (light_sphere) world.spheres.push_back(*light_sphere);
+    scene::Camera camera;
+    camera.position = {0, 0.5, 0};
+    camera.gaze = {0, -1, 0};
+    camera.up = {0, 0, 1};
+    camera.near_distance = 1;
+    camera.near_left = camera.near_bottom = -1e-4;
+    camera.near_right = camera.near_top = 1e-4;
+    camera.width = camera.height = 1;
+    camera.num_samples = 4096;
+    camera.image_name = "out.exr";
+    world.cameras.push_back(camera);
+    return world;
+}
+
+}  // namespace
+
+TEST_CASE_TEMPLATE("ray tracer: object lights light the surfaces they face (their own surface does not shadow them)",
+                   Real, float, double) {
+    using Traced = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::AllLightSet, prism::all_features>;
+    SUBCASE("LightMesh: a unit square at y = 1, centred above the point") {
+        scene::Mesh square;
+        square.material = 1;
+        square.positions = {{-0.5, 1, -0.5}, {0.5, 1, -0.5}, {0.5, 1, 0.5}, {-0.5, 1, 0.5}};
+        square.triangles = {{0, 1, 2}, {0, 2, 3}};
+        square.radiance = {2, 2, 2};
+        const scene::Scene world = floor_under(&square, nullptr);
+        // The irradiance of a parallel rectangle from its corner form factor (Howell's catalogue,
+        // C-11): four 0.5 x 0.5 rectangles at height 1, E = pi L 4 F.
+        const double x = 0.5, root = std::sqrt(1 + x * x);
+        const double corner = (x / root * std::atan(x / root)) / pi;  // 2 (X/sqrt(1+X^2)) atan(..) / (2 pi)
+        const double irradiance = pi * 2.0 * 4 * corner;
+        const prism::Renderer<Traced> renderer(world);
+        const prism::Image image = renderer.render(world.cameras[0]);
+        CHECK(double(image(0, 0).g) == doctest::Approx(irradiance).epsilon(0.02));
+    }
+    SUBCASE("LightSphere: radius 0.25 at height 2, E = pi L (r / d)^2") {
+        scene::Sphere sphere;
+        sphere.material = 1;
+        sphere.center = {0, 2, 0};
+        sphere.radius = 0.25;
+        sphere.radiance = {3, 3, 3};
+        const scene::Scene world = floor_under(nullptr, &sphere);
+        const prism::Renderer<Traced> renderer(world);
+        const prism::Image image = renderer.render(world.cameras[0]);
+        CHECK(double(image(0, 0).g) == doctest::Approx(pi * 3.0 * (0.25 / 2) * (0.25 / 2)).epsilon(0.02));
+    }
+}
+
+TEST_CASE_TEMPLATE("path tracer: a mirror keeps its BRDF terms, as the ray tracer shades it", Real, float, double) {
+    // The floor above, now a mirror (MirrorReflectance 0.5) with diffuse 1: the ray tracer gives
+    // the diffuse term of the LightMesh's light plus the mirrored light (radiance 2 times 0.5);
+    // the path tracer must estimate the same, with and without multiple importance sampling.
+    using Path = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::AllLightSet, prism::all_features,
+                               prism::PathTracer>;
+    scene::Mesh square;
+    square.material = 1;
+    square.positions = {{-0.5, 1, -0.5}, {0.5, 1, -0.5}, {0.5, 1, 0.5}, {-0.5, 1, 0.5}};
+    square.triangles = {{0, 1, 2}, {0, 2, 3}};
+    square.radiance = {2, 2, 2};
+    scene::Scene world = floor_under(&square, nullptr);
+    world.max_recursion_depth = 1;
+    world.materials[0].type = scene::MaterialType::mirror;
+    world.materials[0].mirror = {0.5, 0.5, 0.5};
+    const prism::Renderer<Path> renderer(world);
+    const double traced = double(renderer.render(world.cameras[0])(0, 0).g);
+    const double x = 0.5, root = std::sqrt(1 + x * x);
+    CHECK(traced == doctest::Approx(1.0 + pi * 2.0 * 4 * (x / root * std::atan(x / root)) / pi).epsilon(0.02));
+    for (const bool mis : {false, true}) {
+        CAPTURE(mis);
+        scene::Camera camera = world.cameras[0];
+        camera.renderer = {true, true, true, false, mis};
+        CHECK(double(renderer.render(camera)(0, 0).g) == doctest::Approx(traced).epsilon(0.03));
+    }
+}

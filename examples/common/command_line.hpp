@@ -1,8 +1,9 @@
 // What the example programs share on their command lines: a usage error is one line on stderr
 // and exit status 2, numbers parse whole or not at all, and every program that renders takes the
-// same --threads, --precision, --scale, --max-samples, --ray-offset and --seed with the same checks.
+// same --threads, --precision, --scale, --samples, --max-samples, --ray-offset and --seed with the same checks.
 #pragma once
 
+#include <prism/io/limits.hpp>
 #include <prism/render/render_scene.hpp>
 
 #include <charconv>
@@ -51,6 +52,10 @@ public:
         } else if (option == "--max-samples") {
             options.max_samples = number<int>(option, next_value());
             if (options.max_samples < 1) usage_error("--max-samples must be at least 1");
+        } else if (option == "--samples") {
+            options.samples = number<int>(option, next_value());
+            if (options.samples < 1 || options.samples > io::max_samples_per_pixel)
+                usage_error("--samples must be in [1, " + std::to_string(io::max_samples_per_pixel) + "]");
         } else if (option == "--ray-offset") {
             const std::string_view mode = next_value();
             if (mode == "error-bound") options.ray_offset = RayOffset::error_bound;

@@ -44,6 +44,7 @@ options:
   --precision P        float | double-refine | double: override the precision chosen from the
                        scene (the choice and its reason are printed)
   --scale S            render at S times the cameras' resolution (0 < S <= 1; quick previews)
+  --samples N          N samples per pixel, whatever NumSamples says (before --max-samples)
   --max-samples N      at most N samples per pixel, whatever NumSamples says (quick previews)
   --ray-offset M       how rays leave surfaces: scene-epsilon (the scene's ShadowRayEpsilon
                        along the normal, as the course renders) or error-bound (past the hit

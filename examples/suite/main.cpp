@@ -58,6 +58,9 @@ options:
   --format xml|json    only scene files of this format
   --scale S            render at S times the cameras' resolution (0 < S <= 1); the reference
                        is box-filtered down to the render's size before comparing
+  --samples N          N samples per pixel, whatever NumSamples says (before --max-samples):
+                       a reduced render (--scale) of a noisy reference needs more samples
+                       per pixel to match the reference's noise in each filtered box
   --max-samples N      at most N samples per pixel, whatever NumSamples says
   --threshold DB       PSNR a judged image must reach to pass (default 40)
   --require LEVEL      high | medium | any | none: the least reference confidence that is

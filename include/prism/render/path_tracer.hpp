@@ -12,8 +12,8 @@
 // A path has at most MaxRecursionDepth bounces after the camera's hit, whatever the parameters,
 // so every combination estimates the same image (Russian roulette only thins paths within that
 // bound). Mirrors, conductors and dielectrics scatter as in the course's ray tracer, choosing
-// reflection or refraction by the Fresnel weight. The loop is iterative: the path's length is
-// bounded by the depth, never by native recursion.
+// reflection or refraction by the Fresnel weight, and keep the BRDF terms it shades them with.
+// The loop is iterative: the path's length is bounded by the depth, never by native recursion.
 // Cameras without <Renderer>PathTracing</Renderer> in the same scene render with the course's
 // ray tracer, which this integrator holds.
 #pragma once
@@ -134,13 +134,21 @@ private:
                 throughput *= glm::exp(-material.absorption_coefficient * hit.t);
 
             Vec3<Real> direction;
-            if (material.type != scene::MaterialType::blinn_phong) {
+            // The course's ray tracer shades a mirror, conductor or dielectric with its BRDF (or
+            // Blinn-Phong) terms and adds what it reflects and refracts; so does prism's
+            // (WhittedIntegrator::trace). Here the path continues along one of the two, the
+            // specular one with probability `specular_share`, each divided by its probability;
+            // next-event estimation covers the BRDF terms whichever is taken.
+            const bool specular = material.type != scene::MaterialType::blinn_phong;
+            const Real specular_share = specular ? specular_choice(material, front_face) : Real(0);
+            if (params.next_event_estimation && specular_share < 1)
+                color += throughput * direct_lighting(point, normal, -d, material, params, random, 1 - specular_share);
+            if (specular_share > 0 && (specular_share >= 1 || random.uniform<Real>() < specular_share)) {
                 direction = specular_direction(d, normal, front_face, material, random, throughput);
+                throughput /= specular_share;
                 count_emission = true;
             } else {
                 const Vec3<Real> wo = -d;
-                if (params.next_event_estimation)
-                    color += throughput * direct_lighting(point, normal, wo, material, params, random);
                 Real density;
                 Vec3<Real> value;
                 if (params.importance_sampling) {
@@ -155,6 +163,7 @@ private:
                 }
                 const Real cos_theta = glm::dot(normal, direction);
                 if (!(density > 0) || !(cos_theta > 0)) break;
+                density *= 1 - specular_share;  // the chance of taking the BRDF at all
                 throughput *= value * (cos_theta / density);
                 scatter_pdf = density;
                 count_emission = !params.next_event_estimation;
@@ -206,10 +215,29 @@ private:
         return transmitted;
     }
 
+    // The probability of continuing a path along the specular reflection or refraction of a
+    // mirror, conductor or dielectric rather than its BRDF terms: 1 without such terms (and from
+    // inside a dielectric, which the course does not shade), otherwise in proportion to the
+    // largest specular weight against the largest BRDF weight.
+    static Real specular_choice(const Material<Real>& material, bool front_face) {
+        using scene::MaterialType;
+        if (!front_face && material.type == MaterialType::dielectric) return 1;
+        const Real shaded = std::max({material.diffuse.x, material.diffuse.y, material.diffuse.z}) +
+                            std::max({material.specular.x, material.specular.y, material.specular.z});
+        if (!(shaded > 0)) return 1;
+        const Real reflected = material.type == MaterialType::dielectric
+                                   ? Real(1)
+                                   : std::max({material.mirror.x, material.mirror.y, material.mirror.z});
+        if (!(reflected > 0)) return 0;
+        return std::clamp(reflected / (reflected + shaded), Real(0.1), Real(0.9));
+    }
+
     // Next-event estimation: one sample of every light, as the course's ray tracer takes them.
+    // `brdf_share`: the probability that the path continues by sampling the BRDF here, which
+    // scales that strategy's density in the MIS weight.
     Vec3<Real> direct_lighting(const SurfacePoint<Real>& point, const Vec3<Real>& normal, const Vec3<Real>& wo,
                                const Material<Real>& material, const scene::RendererParams& params,
-                               Random& random) const {
+                               Random& random, Real brdf_share = 1) const {
         Vec3<Real> color(0);
         lights_.for_each([&](const auto& light) {
             const LightSample<Real> sample = light.sample({point.position, normal}, random.uniform2<Real>());
@@ -225,7 +253,8 @@ private:
             if (geometry_.occluded(shadow)) return;
             Vec3<Real> contribution = evaluate_brdf(material, normal, sample.direction, wo) * cos_light * sample.radiance;
             if (params.multiple_importance && sample.pdf > 0)
-                contribution *= path_tracing::power_heuristic(sample.pdf, scatter_density(params, material, normal, sample.direction, wo));
+                contribution *= path_tracing::power_heuristic(
+                    sample.pdf, brdf_share * scatter_density(params, material, normal, sample.direction, wo));
             color += contribution;
         });
         return color;

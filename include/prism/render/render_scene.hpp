@@ -66,6 +66,9 @@ struct RenderOptions {
     std::optional<Precision> precision;   // empty: chosen from the scene
     double resolution_scale = 1.0;        // < 1 renders a reduced image (suite, quick checks)
     int max_samples = 0;                  // > 0 caps every camera's NumSamples (quick checks)
+    // > 0 replaces every camera's NumSamples (before the cap): a reduced image compared with a
+    // box-filtered noisy reference needs more samples per pixel to match its noise per area
+    int samples = 0;
     BackfaceCulling backface_culling = BackfaceCulling::flat_triangles;  // what camera rays skip from behind
     std::optional<RayOffset> ray_offset;  // empty: chosen from the scene (choose_ray_offset)
     std::uint64_t seed = 0;               // the pixels' random streams (multisampling, lights)
@@ -217,6 +220,7 @@ std::vector<CameraImage> render_with(const scene::Scene& scene, const RenderOpti
     std::vector<CameraImage> images;
     for (std::size_t c = 0; c < scene.cameras.size(); ++c) {
         scene::Camera camera = scene.cameras[c];
+        if (options.samples > 0) camera.num_samples = options.samples;
         if (options.max_samples > 0) camera.num_samples = std::min(camera.num_samples, options.max_samples);
         const int width = scaled_size(camera.width, options.resolution_scale);
         const int height = scaled_size(camera.height, options.resolution_scale);

@@ -17,6 +17,7 @@
 
 #include <cmath>
 #include <optional>
+#include <type_traits>
 #include <vector>
 
 namespace prism {
@@ -201,6 +202,11 @@ private:
             if (!std::isinf(sample.distance))
                 shadow.direction = glm::normalize(position + sample.direction * sample.distance - shadow.origin);
             shadow.t_max = sample.distance;
+            // An object light's own surface is at the far end and is geometry: stop short of it,
+            // as the path tracer does, or the light shadows itself (every point black, but for
+            // rounding). Area lights are no geometry, so their rule above stays.
+            if constexpr (std::decay_t<decltype(light)>::kind == scene::LightKind::object)
+                shadow.t_max = glm::length(position + sample.direction * sample.distance - shadow.origin) * (1 - Real(1e-4));
             if (geometry_.occluded(shadow)) return;
             if (material.brdf_given) {
                 color += evaluate_brdf(material, normal, sample.direction, to_viewer) * cos_light * sample.radiance;
