@@ -19,6 +19,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -86,7 +87,9 @@ public:
     // the world's space prepares it once per ray for both levels (geometry/scene_geometry.hpp).
     struct TraversalRay {
         Pack origin[3], inverse_direction[3];
-        int near_plane[3], far_plane[3];  // rows of WideBvhNode::bounds, by the direction's sign
+        // Where the entered and the left plane of each axis start in WideBvhNode::bounds, by
+        // the direction's sign: row times N, an offset the loads add without a multiply.
+        std::ptrdiff_t near_plane[3], far_plane[3];
 
         explicit TraversalRay(const Ray<Real>& ray) {
             const RayBoxPrecomputed<Real> box_ray(ray);
@@ -96,8 +99,8 @@ public:
                 // The sign decides which plane is entered, so no per-child min/max: the same
                 // order the scalar test's swap finds (1/-0 = -inf enters by the high plane).
                 const bool negative = std::signbit(box_ray.inverse_direction[axis]);
-                near_plane[axis] = negative ? 3 + axis : axis;
-                far_plane[axis] = negative ? axis : 3 + axis;
+                near_plane[axis] = (negative ? 3 + axis : axis) * N;
+                far_plane[axis] = (negative ? axis : 3 + axis) * N;
             }
         }
     };
@@ -127,17 +130,19 @@ private:
     // as in the scalar intersect_box.
     [[gnu::always_inline]] static simd::Mask<Real, N> enter(const WideBvhNode<Real, N>& node, const TraversalRay& ray, Real t_min, Real t_max,
                                      Pack& entry) {
-        const Pack scale = Pack::broadcast(far_scale);
+        const Real* planes = &node.bounds[0][0];
         Pack t_enter = Pack::broadcast(t_min);
-        Pack t_exit = Pack::broadcast(t_max * far_scale);
+        Pack t_exit = Pack::broadcast(t_max);
         for (int axis = 0; axis < 3; ++axis) {
-            const Pack t_near = (Pack::load(node.bounds[ray.near_plane[axis]]) - ray.origin[axis]) *
-                                ray.inverse_direction[axis];
-            const Pack t_far = (Pack::load(node.bounds[ray.far_plane[axis]]) - ray.origin[axis]) *
-                               ray.inverse_direction[axis] * scale;
+            const Pack t_near = (Pack::load(planes + ray.near_plane[axis]) - ray.origin[axis]) * ray.inverse_direction[axis];
+            const Pack t_far = (Pack::load(planes + ray.far_plane[axis]) - ray.origin[axis]) * ray.inverse_direction[axis];
             t_enter = simd::max_keep(t_near, t_enter);
             t_exit = simd::min_keep(t_far, t_exit);
         }
+        // Ize's scaling applied once to the nearest exit instead of to every exit and to t_max:
+        // rounding a product by a positive constant is monotone, so the minimum of the scaled
+        // distances is the scaled minimum, bit for bit (NaN distances are skipped either way).
+        t_exit = t_exit * Pack::broadcast(far_scale);
         entry = t_enter;
         return t_enter <= t_exit;
     }
