@@ -14,6 +14,7 @@
 
 #include <prism/accel/bvh_tree.hpp>
 #include <prism/simd/pack.hpp>
+#include <prism/simd/prefetch.hpp>
 
 #include <algorithm>
 #include <array>
@@ -113,6 +114,12 @@ public:
     void traverse_closest(const TraversalRay& ray, Real t_min, Real& t_max, Leaf&& leaf) const {
         traverse<false>(ray, t_min, t_max, leaf);
     }
+    // The same, calling touch(first) for a leaf that is entered but not tested at once, so
+    // that its primitives can be prefetched while nearer children are tested.
+    template <class Leaf, class Touch>
+    void traverse_closest(const TraversalRay& ray, Real t_min, Real& t_max, Leaf&& leaf, Touch&& touch) const {
+        traverse<false>(ray, t_min, t_max, leaf, touch);
+    }
 
     template <class Leaf>
     bool traverse_any(const Ray<Real>& ray, Real t_max, Leaf&& leaf) const {
@@ -121,6 +128,10 @@ public:
     template <class Leaf>
     bool traverse_any(const TraversalRay& ray, Real t_min, Real t_max, Leaf&& leaf) const {
         return traverse<true>(ray, t_min, t_max, leaf);
+    }
+    template <class Leaf, class Touch>
+    bool traverse_any(const TraversalRay& ray, Real t_min, Real t_max, Leaf&& leaf, Touch&& touch) const {
+        return traverse<true>(ray, t_min, t_max, leaf, touch);
     }
 
 private:
@@ -153,8 +164,22 @@ private:
         Real distance;        // where the ray enters its box
     };
 
-    template <bool AnyHit, class Leaf>
-    bool traverse(const TraversalRay& slabs, Real t_min, Real& t_max, Leaf& leaf) const {
+    struct NoTouch {
+        void operator()(std::uint32_t) const {}
+    };
+
+    // A child pushed on the stack is popped only after the nearer ones: its memory is requested
+    // now (the node, or through `touch` the leaf's primitives) so that the wait overlaps them.
+    template <class Touch>
+    [[gnu::always_inline]] void prefetch(const StackEntry& entry, Touch& touch) const {
+        if (entry.count == 0)
+            simd::prefetch(nodes_[entry.child]);
+        else
+            touch(entry.child);
+    }
+
+    template <bool AnyHit, class Leaf, class Touch = NoTouch>
+    bool traverse(const TraversalRay& slabs, Real t_min, Real& t_max, Leaf& leaf, Touch touch = {}) const {
         if (nodes_.empty()) return false;
         std::array<StackEntry, stack_size> stack;
         int size = 0;
@@ -189,6 +214,7 @@ private:
                     if (distances[first] < distances[second]) std::swap(near, far);
                 }
                 stack[size++] = StackEntry{node.child[far], node.count[far], distances[far]};
+                prefetch(stack[size - 1], touch);
                 if (node.count[near] == 0) {
                     current = node.child[near];
                     continue;
@@ -203,6 +229,7 @@ private:
                     const int i = std::countr_zero(hits);
                     hits &= hits - 1;
                     const StackEntry pushed{node.child[i], node.count[i], distances[i]};
+                    prefetch(pushed, touch);
                     int slot = size++;
                     if constexpr (!AnyHit) {
                         while (slot > base && stack[slot - 1].distance < pushed.distance) {

@@ -12,6 +12,7 @@
 #include <prism/geometry/hit.hpp>
 #include <prism/geometry/watertight.hpp>
 #include <prism/simd/pack.hpp>
+#include <prism/simd/prefetch.hpp>
 
 #include <array>
 #include <bit>
@@ -100,6 +101,9 @@ public:
         }
         return found;
     }
+
+    // Requests the packet that holds slot `first` (a leaf's first slot) from memory.
+    void prefetch(std::uint32_t first) const { simd::prefetch(packets_[first / N]); }
 
     // Whether any of slots [first, first + count) is hit in (t_min, t_limit).
     [[gnu::always_inline]] bool occluded(const PackedRay& ray, std::uint32_t first, std::uint32_t count, Real t_min, Real t_limit) const {
