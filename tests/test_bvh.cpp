@@ -22,6 +22,7 @@
 #include <filesystem>
 #include <map>
 #include <random>
+#include <set>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -1022,6 +1023,51 @@ TEST_CASE_TEMPLATE("Indices: a ray prepared once traverses exactly as the ray it
     check_prepared_traversal<prism::WideBvhTree<Real, 4>>(boxes, rays);
     check_prepared_traversal<prism::WideBvhTree<Real, 8>>(boxes, rays);
     check_prepared_traversal<prism::PrimitiveList<Real>>(boxes, rays);
+}
+
+namespace {
+
+// The touch callback (a wide BVH prefetching the leaves it pushes) is a hint: traversal with it
+// visits the same leaves in the same order with the same t_max, and it only ever names leaves.
+template <class Real, int N>
+void check_touched_traversal(const std::vector<prism::Aabb<Real>>& boxes, const std::vector<prism::Ray<Real>>& rays) {
+    const auto tree = prism::WideBvhTree<Real, N>::build(boxes);
+    std::set<std::uint32_t> leaf_starts;
+    for (const auto& node : tree.nodes())
+        for (int i = 0; i < N; ++i)
+            if (node.count[i] != 0) leaf_starts.insert(node.child[i]);
+    std::size_t closest_differ = 0, any_differ = 0, touched = 0, not_leaves = 0;
+    const auto touch = [&](std::uint32_t first) {
+        ++touched;
+        not_leaves += leaf_starts.count(first) == 0;
+    };
+    for (const prism::Ray<Real>& ray : rays) {
+        const typename prism::WideBvhTree<Real, N>::TraversalRay prepared(ray);
+        LeafLog<Real> plain, touching;
+        Real t_plain = ray.t_max, t_touching = ray.t_max;
+        tree.traverse_closest(prepared, ray.t_min, t_plain, plain.closest());
+        tree.traverse_closest(prepared, ray.t_min, t_touching, touching.closest(), touch);
+        closest_differ += plain.visits != touching.visits || t_plain != t_touching;
+        const auto any = [](std::uint32_t first, std::uint32_t, Real&) { return first % 2 == 1; };
+        any_differ += tree.traverse_any(prepared, ray.t_min, ray.t_max, any) !=
+                      tree.traverse_any(prepared, ray.t_min, ray.t_max, any, touch);
+    }
+    CHECK(closest_differ == 0);
+    CHECK(any_differ == 0);
+    CHECK(touched > 0);
+    CHECK(not_leaves == 0);
+}
+
+}  // namespace
+
+TEST_CASE_TEMPLATE("Wide BVH: prefetching pushed leaves changes nothing of the traversal", Real, float, double) {
+    std::vector<glm::dvec3> positions;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    perturbed_sphere(3, 19, positions, triangles);
+    const auto boxes = triangle_boxes<Real>(positions, triangles);
+    const auto rays = test_rays<Real>(bounds_of(positions), positions, 2000, 43);
+    check_touched_traversal<Real, 4>(boxes, rays);
+    check_touched_traversal<Real, 8>(boxes, rays);
 }
 
 TEST_CASE_TEMPLATE("TriangleMesh: the caller's shared ray set-up finds the hits of the mesh's own", Real, float, double) {

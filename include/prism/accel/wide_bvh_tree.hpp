@@ -14,11 +14,13 @@
 
 #include <prism/accel/bvh_tree.hpp>
 #include <prism/simd/pack.hpp>
+#include <prism/simd/prefetch.hpp>
 
 #include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -86,7 +88,9 @@ public:
     // the world's space prepares it once per ray for both levels (geometry/scene_geometry.hpp).
     struct TraversalRay {
         Pack origin[3], inverse_direction[3];
-        int near_plane[3], far_plane[3];  // rows of WideBvhNode::bounds, by the direction's sign
+        // Where the entered and the left plane of each axis start in WideBvhNode::bounds, by
+        // the direction's sign: row times N, an offset the loads add without a multiply.
+        std::ptrdiff_t near_plane[3], far_plane[3];
 
         explicit TraversalRay(const Ray<Real>& ray) {
             const RayBoxPrecomputed<Real> box_ray(ray);
@@ -96,8 +100,8 @@ public:
                 // The sign decides which plane is entered, so no per-child min/max: the same
                 // order the scalar test's swap finds (1/-0 = -inf enters by the high plane).
                 const bool negative = std::signbit(box_ray.inverse_direction[axis]);
-                near_plane[axis] = negative ? 3 + axis : axis;
-                far_plane[axis] = negative ? axis : 3 + axis;
+                near_plane[axis] = (negative ? 3 + axis : axis) * N;
+                far_plane[axis] = (negative ? axis : 3 + axis) * N;
             }
         }
     };
@@ -110,6 +114,12 @@ public:
     void traverse_closest(const TraversalRay& ray, Real t_min, Real& t_max, Leaf&& leaf) const {
         traverse<false>(ray, t_min, t_max, leaf);
     }
+    // The same, calling touch(first) for a leaf that is entered but not tested at once, so
+    // that its primitives can be prefetched while nearer children are tested.
+    template <class Leaf, class Touch>
+    void traverse_closest(const TraversalRay& ray, Real t_min, Real& t_max, Leaf&& leaf, Touch&& touch) const {
+        traverse<false>(ray, t_min, t_max, leaf, touch);
+    }
 
     template <class Leaf>
     bool traverse_any(const Ray<Real>& ray, Real t_max, Leaf&& leaf) const {
@@ -119,6 +129,10 @@ public:
     bool traverse_any(const TraversalRay& ray, Real t_min, Real t_max, Leaf&& leaf) const {
         return traverse<true>(ray, t_min, t_max, leaf);
     }
+    template <class Leaf, class Touch>
+    bool traverse_any(const TraversalRay& ray, Real t_min, Real t_max, Leaf&& leaf, Touch&& touch) const {
+        return traverse<true>(ray, t_min, t_max, leaf, touch);
+    }
 
 private:
 
@@ -127,17 +141,19 @@ private:
     // as in the scalar intersect_box.
     [[gnu::always_inline]] static simd::Mask<Real, N> enter(const WideBvhNode<Real, N>& node, const TraversalRay& ray, Real t_min, Real t_max,
                                      Pack& entry) {
-        const Pack scale = Pack::broadcast(far_scale);
+        const Real* planes = &node.bounds[0][0];
         Pack t_enter = Pack::broadcast(t_min);
-        Pack t_exit = Pack::broadcast(t_max * far_scale);
+        Pack t_exit = Pack::broadcast(t_max);
         for (int axis = 0; axis < 3; ++axis) {
-            const Pack t_near = (Pack::load(node.bounds[ray.near_plane[axis]]) - ray.origin[axis]) *
-                                ray.inverse_direction[axis];
-            const Pack t_far = (Pack::load(node.bounds[ray.far_plane[axis]]) - ray.origin[axis]) *
-                               ray.inverse_direction[axis] * scale;
+            const Pack t_near = (Pack::load(planes + ray.near_plane[axis]) - ray.origin[axis]) * ray.inverse_direction[axis];
+            const Pack t_far = (Pack::load(planes + ray.far_plane[axis]) - ray.origin[axis]) * ray.inverse_direction[axis];
             t_enter = simd::max_keep(t_near, t_enter);
             t_exit = simd::min_keep(t_far, t_exit);
         }
+        // Ize's scaling applied once to the nearest exit instead of to every exit and to t_max:
+        // rounding a product by a positive constant is monotone, so the minimum of the scaled
+        // distances is the scaled minimum, bit for bit (NaN distances are skipped either way).
+        t_exit = t_exit * Pack::broadcast(far_scale);
         entry = t_enter;
         return t_enter <= t_exit;
     }
@@ -148,8 +164,22 @@ private:
         Real distance;        // where the ray enters its box
     };
 
-    template <bool AnyHit, class Leaf>
-    bool traverse(const TraversalRay& slabs, Real t_min, Real& t_max, Leaf& leaf) const {
+    struct NoTouch {
+        void operator()(std::uint32_t) const {}
+    };
+
+    // A child pushed on the stack is popped only after the nearer ones: its memory is requested
+    // now (the node, or through `touch` the leaf's primitives) so that the wait overlaps them.
+    template <class Touch>
+    [[gnu::always_inline]] void prefetch(const StackEntry& entry, Touch& touch) const {
+        if (entry.count == 0)
+            simd::prefetch(nodes_[entry.child]);
+        else
+            touch(entry.child);
+    }
+
+    template <bool AnyHit, class Leaf, class Touch = NoTouch>
+    bool traverse(const TraversalRay& slabs, Real t_min, Real& t_max, Leaf& leaf, Touch touch = {}) const {
         if (nodes_.empty()) return false;
         std::array<StackEntry, stack_size> stack;
         int size = 0;
@@ -184,6 +214,7 @@ private:
                     if (distances[first] < distances[second]) std::swap(near, far);
                 }
                 stack[size++] = StackEntry{node.child[far], node.count[far], distances[far]};
+                prefetch(stack[size - 1], touch);
                 if (node.count[near] == 0) {
                     current = node.child[near];
                     continue;
@@ -198,6 +229,7 @@ private:
                     const int i = std::countr_zero(hits);
                     hits &= hits - 1;
                     const StackEntry pushed{node.child[i], node.count[i], distances[i]};
+                    prefetch(pushed, touch);
                     int slot = size++;
                     if constexpr (!AnyHit) {
                         while (slot > base && stack[slot - 1].distance < pushed.distance) {
