@@ -155,10 +155,6 @@ struct Point {
     double median() const { return cpu.median(); }
 };
 
-bool same_bits(const prism::Image& a, const prism::Image& b) {
-    return a.width == b.width && a.height == b.height &&
-           std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(a.pixels[0])) == 0;
-}
 
 [[noreturn]] void fail(const std::string& message) { throw std::runtime_error(message); }
 
@@ -246,7 +242,7 @@ SceneResult measure_scene(std::size_t scene_index, const Options& options) {
                 images[v] = std::move(image);
                 continue;
             }
-            if (!same_bits(image, images[v]))
+            if (!prism::same_bits(image, images[v]))
                 fail(chart_scene.name + ", " + variants()[v].name + ": run " + std::to_string(round) +
                      " rendered a different image from the first: the timing would not measure one computation");
             result.points[v].cpu.seconds.push_back(cpu_seconds);
@@ -259,7 +255,7 @@ SceneResult measure_scene(std::size_t scene_index, const Options& options) {
     // deterministic, or the reference is no reference.
     {
         const RenderFunction again = variants()[reference_index].build(scene);
-        if (!same_bits(again(camera, width, height), images[reference_index]))
+        if (!prism::same_bits(again(camera, width, height), images[reference_index]))
             fail(chart_scene.name + ": the reference rendered by a second, separately built renderer differs");
     }
 
@@ -564,11 +560,9 @@ int run(int argc, char** argv) {
     const std::string date = utc_now();
     const Options options = parse(argc, argv);
 
-    std::string missing;
-    for (const ChartScene& chart_scene : chart_scenes())
-        if (!fs::exists(options.shared / chart_scene.file))
-            missing += "\n  " + chart_scene.name + ": " + (options.shared / chart_scene.file).string();
-    if (!missing.empty()) fail("scene file(s) not found (set --shared to the folder holding ceng795/):" + missing);
+    std::vector<std::pair<std::string, std::string>> files;
+    for (const ChartScene& chart_scene : chart_scenes()) files.emplace_back(chart_scene.name, chart_scene.file);
+    require_files(options.shared, files);
     fs::create_directories(options.output_dir);
     if (options.write_images) fs::create_directories(options.output_dir / "images");
 
@@ -635,11 +629,4 @@ int run(int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-    try {
-        return run(argc, argv);
-    } catch (const std::exception& error) {
-        std::cerr << "prism_accuracy_chart: " << error.what() << "\n";
-        return 1;
-    }
-}
+int main(int argc, char** argv) { return prism::bench::run_reporting_errors("prism_accuracy_chart", run, argc, argv); }

@@ -9,8 +9,10 @@
 #include <algorithm>
 #include <cstddef>
 #include <ctime>
+#include <exception>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -90,6 +92,27 @@ inline void update_marked_section(const std::filesystem::path& path, const std::
         if (!out) throw std::runtime_error("could not write " + temporary.string());
     }
     std::filesystem::rename(temporary, path);
+}
+
+// Every file a chart needs, checked before anything is rendered: one error naming each missing
+// one. `files` holds (name as the chart shows it, path under `shared`) pairs.
+template <class Files>
+void require_files(const std::filesystem::path& shared, const Files& files) {
+    std::string missing;
+    for (const auto& [name, file] : files)
+        if (!std::filesystem::exists(shared / file)) missing += "\n  " + name + ": " + (shared / file).string();
+    if (!missing.empty())
+        throw std::runtime_error("scene file(s) not found (set --shared to the folder holding ceng795/):" + missing);
+}
+
+// A benchmark program's main: its run, and any error as one line naming the program, exit 1.
+inline int run_reporting_errors(const char* program, int (*run)(int, char**), int argc, char** argv) {
+    try {
+        return run(argc, argv);
+    } catch (const std::exception& error) {
+        std::cerr << program << ": " << error.what() << "\n";
+        return 1;
+    }
 }
 
 }  // namespace prism::bench

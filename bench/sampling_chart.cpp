@@ -156,10 +156,6 @@ double relative_rmse(const prism::Image& image, const prism::Image& reference) {
     return std::sqrt(square / n) / (mean / n);
 }
 
-bool same_bits(const prism::Image& a, const prism::Image& b) {
-    return a.width == b.width && a.height == b.height &&
-           std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(a.pixels[0])) == 0;
-}
 
 bool finite(const prism::Image& image) {
     for (const glm::vec3& p : image.pixels)
@@ -247,7 +243,7 @@ SceneResult measure_scene(const ChartScene& chart_scene, const Options& options)
                     images[v] = std::move(image);
                     continue;
                 }
-                if (!same_bits(image, images[v]))
+                if (!prism::same_bits(image, images[v]))
                     fail(chart_scene.name + ", " + variants()[v].name + ", " + std::to_string(options.samples[s]) +
                          " samples: run " + std::to_string(round) + " rendered a different image from the first");
                 result.points[v][s].cpu.seconds.push_back(cpu_seconds);
@@ -505,11 +501,9 @@ int run(int argc, char** argv) {
     const std::string start_load = load_average();
     const std::string date = utc_now();
     const Options options = parse(argc, argv);
-    std::string missing;
-    for (const ChartScene& chart_scene : chart_scenes())
-        if (!fs::exists(options.shared / chart_scene.file))
-            missing += "\n  " + chart_scene.name + ": " + (options.shared / chart_scene.file).string();
-    if (!missing.empty()) fail("scene file(s) not found (set --shared to the folder holding ceng795/):" + missing);
+    std::vector<std::pair<std::string, std::string>> files;
+    for (const ChartScene& chart_scene : chart_scenes()) files.emplace_back(chart_scene.name, chart_scene.file);
+    require_files(options.shared, files);
     fs::create_directories(options.output_dir);
 
     std::vector<SceneResult> results;
@@ -564,11 +558,4 @@ int run(int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-    try {
-        return run(argc, argv);
-    } catch (const std::exception& error) {
-        std::cerr << "prism_sampling_chart: " << error.what() << "\n";
-        return 1;
-    }
-}
+int main(int argc, char** argv) { return prism::bench::run_reporting_errors("prism_sampling_chart", run, argc, argv); }
