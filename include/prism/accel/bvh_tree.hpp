@@ -346,16 +346,17 @@ private:
             } else {
                 if (count <= options.max_leaf_size && leaf_cost <= split_cost) return make_leaf(node, begin, end);
                 // The children's centroid bounds, gathered lane by lane as the partition sees
-                // each box (the same minima and maxima Aabb::extend would find).
-                BuildBox left_lanes = BuildBox::empty(), right_lanes = BuildBox::empty();
+                // each box (the same minima and maxima Aabb::extend would find), indexed by
+                // side rather than chosen by a branch the data would mispredict.
+                std::array<BuildBox, 2> centroid_lanes{BuildBox::empty(), BuildBox::empty()};  // right, left
                 const auto goes_left = [&](const BuildBox& box) {
                     const bool left = bin_of(box, best_axis) < best_split;
-                    (left ? left_lanes : right_lanes).extend(box.centroid_lanes());
+                    centroid_lanes[left].extend(box.centroid_lanes());
                     return left;
                 };
                 middle = begin + partition(begin, end, goes_left);
-                left_centroids = left_lanes.aabb();
-                right_centroids = right_lanes.aabb();
+                left_centroids = centroid_lanes[1].aabb();
+                right_centroids = centroid_lanes[0].aabb();
             }
 
             const std::uint32_t left = node_count.fetch_add(2);
@@ -374,25 +375,52 @@ private:
 
         // Moves the primitives of [begin, end) for which goes_left holds to the front, boxes and
         // indices together, and returns how many there are; goes_left sees each primitive once.
-        // The swaps are those of libstdc++'s std::partition (Hoare's scheme from both ends),
-        // which this builder used before, so the primitive order is unchanged.
+        // The swaps are those of libstdc++'s std::partition, which this builder used before, so
+        // the primitive order is unchanged. Hoare's scheme from both ends swaps the k-th
+        // primitive from the front that goes right with the k-th from the back that goes left,
+        // until the two meet where the left ones end. Written as that scan, it takes a branch
+        // per primitive that the data mispredicts half the time; here the same pairs are found
+        // in branch-free passes: each primitive's side, then the misplaced ones of each part.
         template <class GoesLeft>
         std::uint32_t partition(std::uint32_t begin, std::uint32_t end, const GoesLeft& goes_left) {
-            std::uint32_t first = begin, last = end;
-            for (;;) {
-                for (;; ++first) {
-                    if (first == last) return first - begin;
-                    if (!goes_left(boxes[first])) break;
-                }
-                --last;
-                for (;; --last) {
-                    if (first == last) return first - begin;
-                    if (goes_left(boxes[last])) break;
-                }
-                std::swap(boxes[first], boxes[last]);
-                std::swap(indices[first], indices[last]);
-                ++first;
+            const std::uint32_t count = end - begin;
+            constexpr std::uint32_t on_stack = 1024;
+            std::array<std::uint8_t, on_stack> stack_sides;
+            std::array<std::uint32_t, on_stack + 1> stack_moves;
+            std::vector<std::uint8_t> heap_sides;
+            std::vector<std::uint32_t> heap_moves;
+            std::uint8_t* sides = stack_sides.data();
+            std::uint32_t* moves = stack_moves.data();
+            if (count > on_stack) {
+                heap_sides.resize(count);
+                heap_moves.resize(std::size_t(count) + 1);
+                sides = heap_sides.data();
+                moves = heap_moves.data();
             }
+            std::uint32_t left_count = 0;
+            for (std::uint32_t i = 0; i < count; ++i) {
+                const bool left = goes_left(boxes[begin + i]);
+                sides[i] = left;
+                left_count += left;
+            }
+            // Right-goers in the front part, first to last; then left-goers in the back part,
+            // last to first. There are as many of each; every slot is written, kept or not.
+            std::uint32_t misplaced = 0;
+            for (std::uint32_t i = 0; i < left_count; ++i) {
+                moves[misplaced] = i;
+                misplaced += sides[i] ^ 1u;
+            }
+            std::uint32_t* const from_back = moves + misplaced;
+            std::uint32_t found = 0;
+            for (std::uint32_t i = count; i-- > left_count;) {
+                from_back[found] = i;
+                found += sides[i];
+            }
+            for (std::uint32_t k = 0; k < misplaced; ++k) {
+                std::swap(boxes[begin + moves[k]], boxes[begin + from_back[k]]);
+                std::swap(indices[begin + moves[k]], indices[begin + from_back[k]]);
+            }
+            return left_count;
         }
     };
 
