@@ -941,6 +941,27 @@ void check_wide_trees() {
         const std::vector<prism::Aabb<Real>> few(sphere_boxes.begin(), sphere_boxes.begin() + std::ptrdiff_t(count));
         check_wide_structure(prism::WideBvhTree<Real, N>::build(few), few);
     }
+    // Smaller leaves on request (a scene's top level asks for one instance per leaf); a larger
+    // request is held to N, the width of the triangle packets.
+    for (const std::uint32_t max_leaf_size : {1u, 3u}) {
+        prism::BvhBuildOptions options;
+        options.max_leaf_size = max_leaf_size;
+        for (const std::vector<prism::Aabb<Real>>* input : {&sphere_boxes, &std::as_const(one_centre)}) {
+            const auto tree = prism::WideBvhTree<Real, N>::build(*input, options);
+            check_wide_structure(tree, *input);
+            std::uint32_t largest = 0;
+            for (const auto& node : tree.nodes())
+                for (int c = 0; c < N; ++c) largest = std::max(largest, node.count[c]);
+            CHECK(largest >= 1);
+            CHECK(largest <= max_leaf_size);
+        }
+    }
+    prism::BvhBuildOptions too_large;
+    too_large.max_leaf_size = 1000;
+    const auto held = prism::WideBvhTree<Real, N>::build(sphere_boxes, too_large);
+    const auto standard = prism::WideBvhTree<Real, N>::build(sphere_boxes);
+    CHECK(held.nodes().size() == standard.nodes().size());
+    CHECK(held.primitive_indices() == standard.primitive_indices());
     // The geometric progression drives the binary build to its depth cap, leaving leaves of
     // more than N primitives: traversal must still reach every one of them.
     std::vector<prism::Aabb<Real>> boxes;

@@ -14,6 +14,7 @@
 #include <array>
 #include <cfloat>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <type_traits>
@@ -66,6 +67,28 @@ TEST_CASE_TEMPLATE("next_up and next_down step to the neighbouring value of the 
     CHECK(next_up(std::numeric_limits<Real>::max()) == prism::infinity<Real>);
     CHECK(next_up(Real(1000)) > Real(1000));
     CHECK(next_down(Real(1000)) < Real(1000));
+}
+
+TEST_CASE_TEMPLATE("next_up and next_down give std::nextafter's values, to the bit", Real, float, double) {
+    using limits = std::numeric_limits<Real>;
+    std::vector<Real> values = {Real(0),        -Real(0),         limits::denorm_min(), limits::min(),
+                                limits::max(),  limits::infinity(), limits::epsilon(),  Real(1),
+                                Real(0.1),      Real(3.7),          Real(-2.5e-30),     Real(1e30)};
+    const std::size_t listed = values.size();
+    for (std::size_t i = 0; i < listed; ++i) values.push_back(-values[i]);
+    // Across binade edges and through the subnormals.
+    for (Real v = limits::denorm_min(); v < Real(1e6); v *= Real(3.3)) values.insert(values.end(), {v, -v});
+    for (const Real v : values) {
+        const Real up = prism::next_up(v), down = prism::next_down(v);
+        const Real expected_up = std::nextafter(v, limits::infinity());
+        const Real expected_down = std::nextafter(v, -limits::infinity());
+        CAPTURE(v);
+        CHECK(std::memcmp(&up, &expected_up, sizeof(Real)) == 0);
+        CHECK(std::memcmp(&down, &expected_down, sizeof(Real)) == 0);
+    }
+    CHECK(std::isnan(prism::next_up(limits::quiet_NaN())));
+    CHECK(std::isnan(prism::next_down(limits::quiet_NaN())));
+    CHECK(prism::next_down(-limits::max()) == -limits::infinity());
 }
 
 TEST_CASE("next_up and next_down: double steps are double-sized, float steps float-sized") {

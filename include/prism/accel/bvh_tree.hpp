@@ -12,7 +12,10 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
+#include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <numeric>
 #include <span>
 #include <vector>
@@ -54,12 +57,18 @@ public:
             root_bounds.extend(boxes[i]);
             centroid_bounds.extend(boxes[i].centroid());
         }
-        tree.nodes_.resize(2 * std::size_t(count) - 1);
-        tree.nodes_[0].bounds = root_bounds;
-        Builder builder{build_boxes, tree.primitive_indices_, tree.nodes_, options, {1}};
+        // A tree has at most 2 count - 1 nodes, but leaves of several primitives make far fewer.
+        // The builder writes into storage of the bound left uninitialised, and only the nodes
+        // made are copied out: the pages of the unused part are never touched (initialising
+        // them, and copying to shrink afterwards, cost a tenth of the dragon's build in page
+        // faults). Every node is written before it is read; the bytes become BvhNodes the way
+        // any storage from new std::byte[] does (C++20 implicit object creation).
+        const auto storage = std::make_unique_for_overwrite<std::byte[]>((2 * std::size_t(count) - 1) * sizeof(BvhNode<Real>));
+        BvhNode<Real>* const nodes = reinterpret_cast<BvhNode<Real>*>(storage.get());
+        nodes[0] = {root_bounds, 0, 0};
+        Builder builder{build_boxes, tree.primitive_indices_, nodes, options, {1}};
         builder.build(0, 0, count, centroid_bounds, 0);
-        tree.nodes_.resize(builder.node_count.load());
-        tree.nodes_.shrink_to_fit();
+        tree.nodes_.assign(nodes, nodes + builder.node_count.load());
         return tree;
     }
 
@@ -168,6 +177,24 @@ private:
                 max[k] = max[k] < other.max[k] ? other.max[k] : max[k];
             }
         }
+        // glm::min(min, point), as Aabb::extend(point) takes it.
+        void extend(const std::array<Real, 4>& point) {
+            for (int k = 0; k < 4; ++k) {
+                min[k] = point[k] < min[k] ? point[k] : min[k];
+                max[k] = max[k] < point[k] ? point[k] : max[k];
+            }
+        }
+        std::array<Real, 4> centroid_lanes() const {
+            std::array<Real, 4> c;
+            for (int k = 0; k < 4; ++k) c[k] = (min[k] + max[k]) * Real(0.5);
+            return c;
+        }
+        // Aabb::half_area's operations in its order, so the SAH costs keep their bits.
+        Real half_area() const {
+            if (min[0] > max[0] || min[1] > max[1] || min[2] > max[2]) return 0;
+            const Real x = max[0] - min[0], y = max[1] - min[1], z = max[2] - min[2];
+            return x * y + y * z + z * x;
+        }
         static BuildBox empty() {
             return {{infinity<Real>, infinity<Real>, infinity<Real>, infinity<Real>},
                     {-infinity<Real>, -infinity<Real>, -infinity<Real>, -infinity<Real>}};
@@ -177,7 +204,7 @@ private:
     struct Builder {
         std::vector<BuildBox>& boxes;  // in the order of indices
         std::vector<std::uint32_t>& indices;
-        std::vector<BvhNode<Real>>& nodes;
+        BvhNode<Real>* nodes;  // room for 2 count - 1
         const BvhBuildOptions& options;
         std::atomic<std::uint32_t> node_count;
 
@@ -189,13 +216,33 @@ private:
         struct BinSet {
             std::array<std::array<BuildBox, max_bins>, 3> bounds;
             std::array<std::array<std::uint32_t, max_bins>, 3> counts;
+            std::array<std::uint64_t, 3> occupied;  // bit b: bin b holds a primitive
 
             void reset(int bin_count) {
-                for (int axis = 0; axis < 3; ++axis)
+                for (int axis = 0; axis < 3; ++axis) {
                     for (int b = 0; b < bin_count; ++b) {
                         bounds[axis][b] = BuildBox::empty();
                         counts[axis][b] = 0;
                     }
+                    occupied[axis] = 0;
+                }
+            }
+            // Inlined by force: GCC kept it a call, and the box then went through the stack.
+            [[gnu::always_inline]] void add(const BuildBox& box, const std::array<int, 4>& bin) {
+                for (int axis = 0; axis < 3; ++axis) {
+                    bounds[axis][bin[axis]].extend(box);
+                    ++counts[axis][bin[axis]];
+                    occupied[axis] |= std::uint64_t(1) << bin[axis];
+                }
+            }
+            void merge(const BinSet& other, int bin_count) {
+                for (int axis = 0; axis < 3; ++axis) {
+                    for (int b = 0; b < bin_count; ++b) {
+                        bounds[axis][b].extend(other.bounds[axis][b]);
+                        counts[axis][b] += other.counts[axis][b];
+                    }
+                    occupied[axis] |= other.occupied[axis];
+                }
             }
         };
 
@@ -241,31 +288,19 @@ private:
             // afterwards: neighbours often fall in the same bin, and with one set each update
             // waits for the previous one's store. Minimum, maximum and count do not depend on
             // the order, so the bins (and the tree) are the same.
-            const auto add = [&](BinSet& set, const BuildBox& box) {
-                const std::array<int, 4> bin = bins_of(box);
-                for (int axis = 0; axis < 3; ++axis) {
-                    const int b = bin[axis];
-                    set.bounds[axis][b].extend(box);
-                    ++set.counts[axis][b];
-                }
-            };
             BinSet bins, odd_bins;
             bins.reset(bin_count);
             if (count >= two_bin_sets_from) {
                 odd_bins.reset(bin_count);
                 std::uint32_t i = 0;
                 for (; i + 1 < count; i += 2) {
-                    add(bins, range[i]);
-                    add(odd_bins, range[i + 1]);
+                    bins.add(range[i], bins_of(range[i]));
+                    odd_bins.add(range[i + 1], bins_of(range[i + 1]));
                 }
-                if (i < count) add(bins, range[i]);
-                for (int axis = 0; axis < 3; ++axis)
-                    for (int b = 0; b < bin_count; ++b) {
-                        bins.bounds[axis][b].extend(odd_bins.bounds[axis][b]);
-                        bins.counts[axis][b] += odd_bins.counts[axis][b];
-                    }
+                if (i < count) bins.add(range[i], bins_of(range[i]));
+                bins.merge(odd_bins, bin_count);
             } else {
-                for (std::uint32_t i = 0; i < count; ++i) add(bins, range[i]);
+                for (std::uint32_t i = 0; i < count; ++i) bins.add(range[i], bins_of(range[i]));
             }
 
             int best_axis = -1, best_split = 0;
@@ -273,29 +308,40 @@ private:
             Aabb<Real> best_left, best_right;
             for (int axis = 0; axis < 3; ++axis) {
                 if (!splittable[axis]) continue;
-                // Sweep from the right, then from the left, evaluating every plane between bins.
+                // Sweep from the right, then from the left, over the bins that hold primitives.
+                // A plane after an empty bin splits the primitives as the plane before that bin
+                // does, at the same cost, so the strict `cost < best_cost` never takes it: only
+                // the planes just after a filled bin are evaluated, which in the many small
+                // nodes near the leaves (a handful of primitives in 16 bins) saves most of the
+                // sweep. The boxes are extended in the same order as a sweep over every bin
+                // (empty bins change nothing), so the costs, and the tree, keep their bits.
+                std::array<int, max_bins> filled;
+                int filled_count = 0;
+                for (std::uint64_t mask = bins.occupied[axis]; mask != 0; mask &= mask - 1)
+                    filled[filled_count++] = std::countr_zero(mask);
+                // right_bounds[j] bounds the filled bins j, j + 1, ...; right_cost[j] is its SAH term.
                 std::array<Real, max_bins> right_cost;
-                std::array<Aabb<Real>, max_bins> right_bounds;
-                Aabb<Real> accumulated;
+                std::array<BuildBox, max_bins> right_bounds;
+                BuildBox accumulated = BuildBox::empty();
                 std::uint32_t accumulated_count = 0;
-                for (int b = bin_count - 1; b > 0; --b) {
-                    accumulated.extend(bins.bounds[axis][b].aabb());
-                    accumulated_count += bins.counts[axis][b];
-                    right_bounds[b] = accumulated;
-                    right_cost[b] = accumulated.half_area() * Real(accumulated_count);
+                for (int j = filled_count - 1; j > 0; --j) {
+                    accumulated.extend(bins.bounds[axis][filled[j]]);
+                    accumulated_count += bins.counts[axis][filled[j]];
+                    right_bounds[j] = accumulated;
+                    right_cost[j] = accumulated.half_area() * Real(accumulated_count);
                 }
-                accumulated = {};
+                accumulated = BuildBox::empty();
                 accumulated_count = 0;
-                for (int b = 0; b < bin_count - 1; ++b) {
-                    accumulated.extend(bins.bounds[axis][b].aabb());
-                    accumulated_count += bins.counts[axis][b];
-                    const Real cost = accumulated.half_area() * Real(accumulated_count) + right_cost[b + 1];
-                    if (accumulated_count > 0 && accumulated_count < count && cost < best_cost) {
+                for (int j = 0; j + 1 < filled_count; ++j) {
+                    accumulated.extend(bins.bounds[axis][filled[j]]);
+                    accumulated_count += bins.counts[axis][filled[j]];
+                    const Real cost = accumulated.half_area() * Real(accumulated_count) + right_cost[j + 1];
+                    if (cost < best_cost) {
                         best_cost = cost;
                         best_axis = axis;
-                        best_split = b + 1;
-                        best_left = accumulated;
-                        best_right = right_bounds[b + 1];
+                        best_split = filled[j] + 1;
+                        best_left = accumulated.aabb();
+                        best_right = right_bounds[j + 1].aabb();
                     }
                 }
             }
@@ -317,19 +363,25 @@ private:
                 left_centroids = right_centroids = centroid_bounds;  // all the same point
             } else {
                 if (count <= options.max_leaf_size && leaf_cost <= split_cost) return make_leaf(node, begin, end);
+                // The children's centroid bounds, gathered lane by lane as the partition sees
+                // each box (the same minima and maxima Aabb::extend would find), indexed by
+                // side rather than chosen by a branch the data would mispredict.
+                std::array<BuildBox, 2> centroid_lanes{BuildBox::empty(), BuildBox::empty()};  // right, left
                 const auto goes_left = [&](const BuildBox& box) {
                     const bool left = bin_of(box, best_axis) < best_split;
-                    (left ? left_centroids : right_centroids).extend(box.centroid());
+                    centroid_lanes[left].extend(box.centroid_lanes());
                     return left;
                 };
                 middle = begin + partition(begin, end, goes_left);
+                left_centroids = centroid_lanes[1].aabb();
+                right_centroids = centroid_lanes[0].aabb();
             }
 
             const std::uint32_t left = node_count.fetch_add(2);
             nodes[node].index = left;
             nodes[node].count = 0;
-            nodes[left].bounds = best_left;
-            nodes[left + 1].bounds = best_right;
+            nodes[left] = {best_left, 0, 0};
+            nodes[left + 1] = {best_right, 0, 0};
             if (count >= options.parallel_threshold) {
                 tbb::parallel_invoke([&] { build(left, begin, middle, left_centroids, depth + 1); },
                                      [&] { build(left + 1, middle, end, right_centroids, depth + 1); });
@@ -341,25 +393,52 @@ private:
 
         // Moves the primitives of [begin, end) for which goes_left holds to the front, boxes and
         // indices together, and returns how many there are; goes_left sees each primitive once.
-        // The swaps are those of libstdc++'s std::partition (Hoare's scheme from both ends),
-        // which this builder used before, so the primitive order is unchanged.
+        // The swaps are those of libstdc++'s std::partition, which this builder used before, so
+        // the primitive order is unchanged. Hoare's scheme from both ends swaps the k-th
+        // primitive from the front that goes right with the k-th from the back that goes left,
+        // until the two meet where the left ones end. Written as that scan, it takes a branch
+        // per primitive that the data mispredicts half the time; here the same pairs are found
+        // in branch-free passes: each primitive's side, then the misplaced ones of each part.
         template <class GoesLeft>
         std::uint32_t partition(std::uint32_t begin, std::uint32_t end, const GoesLeft& goes_left) {
-            std::uint32_t first = begin, last = end;
-            for (;;) {
-                for (;; ++first) {
-                    if (first == last) return first - begin;
-                    if (!goes_left(boxes[first])) break;
-                }
-                --last;
-                for (;; --last) {
-                    if (first == last) return first - begin;
-                    if (goes_left(boxes[last])) break;
-                }
-                std::swap(boxes[first], boxes[last]);
-                std::swap(indices[first], indices[last]);
-                ++first;
+            const std::uint32_t count = end - begin;
+            constexpr std::uint32_t on_stack = 1024;
+            std::array<std::uint8_t, on_stack> stack_sides;
+            std::array<std::uint32_t, on_stack + 1> stack_moves;
+            std::vector<std::uint8_t> heap_sides;
+            std::vector<std::uint32_t> heap_moves;
+            std::uint8_t* sides = stack_sides.data();
+            std::uint32_t* moves = stack_moves.data();
+            if (count > on_stack) {
+                heap_sides.resize(count);
+                heap_moves.resize(std::size_t(count) + 1);
+                sides = heap_sides.data();
+                moves = heap_moves.data();
             }
+            std::uint32_t left_count = 0;
+            for (std::uint32_t i = 0; i < count; ++i) {
+                const bool left = goes_left(boxes[begin + i]);
+                sides[i] = left;
+                left_count += left;
+            }
+            // Right-goers in the front part, first to last; then left-goers in the back part,
+            // last to first. There are as many of each; every slot is written, kept or not.
+            std::uint32_t misplaced = 0;
+            for (std::uint32_t i = 0; i < left_count; ++i) {
+                moves[misplaced] = i;
+                misplaced += sides[i] ^ 1u;
+            }
+            std::uint32_t* const from_back = moves + misplaced;
+            std::uint32_t found = 0;
+            for (std::uint32_t i = count; i-- > left_count;) {
+                from_back[found] = i;
+                found += sides[i];
+            }
+            for (std::uint32_t k = 0; k < misplaced; ++k) {
+                std::swap(boxes[begin + moves[k]], boxes[begin + from_back[k]]);
+                std::swap(indices[begin + moves[k]], indices[begin + from_back[k]]);
+            }
+            return left_count;
         }
     };
 

@@ -49,14 +49,16 @@ public:
 
     WideBvhTree() = default;
 
-    static WideBvhTree build(std::span<const Aabb<Real>> boxes) {
-        BvhBuildOptions options;
-        options.max_leaf_size = N;
+    // `options.max_leaf_size` (at most N; N by default) bounds the primitives of a leaf. The
+    // top level of a scene asks for 1: an instance costs a transform and a whole BVH, far more
+    // than a box test, so each gets a box of its own.
+    static WideBvhTree build(std::span<const Aabb<Real>> boxes, BvhBuildOptions options = {.max_leaf_size = N}) {
+        options.max_leaf_size = std::clamp<std::uint32_t>(options.max_leaf_size, 1, N);
         const BvhTree<Real> binary = BvhTree<Real>::build(boxes, options);
         WideBvhTree tree;
         if (boxes.empty()) return tree;
         tree.bounds_ = binary.bounds();
-        Collapser collapser{binary, tree, {}};
+        Collapser collapser{binary, tree, options.max_leaf_size, {}};
         collapser.ranges.resize(binary.nodes().size());
         collapser.measure(0);
         if (binary.nodes()[0].is_leaf()) {
@@ -274,6 +276,7 @@ private:
     struct Collapser {
         const BvhTree<Real>& binary;
         WideBvhTree& tree;
+        std::uint32_t max_leaf_size;
         struct Range {
             std::uint32_t begin, end;
         };
@@ -286,7 +289,7 @@ private:
             return ranges[i] = {left.begin, right.end};
         }
 
-        bool becomes_leaf(std::uint32_t i) const { return ranges[i].end - ranges[i].begin <= std::uint32_t(N) || binary.nodes()[i].is_leaf(); }
+        bool becomes_leaf(std::uint32_t i) const { return ranges[i].end - ranges[i].begin <= max_leaf_size || binary.nodes()[i].is_leaf(); }
 
         // Makes the wide node for binary inner node i; returns its index.
         std::uint32_t collapse(std::uint32_t i) {
