@@ -291,10 +291,7 @@ private:
 
     Ray<Real> leaving(const SurfacePoint<Real>& point, const Vec3<Real>& normal, const Vec3<Real>& direction,
                       Real time) const {
-        Ray<Real> ray{Vec3<Real>(0), direction, Real(0), infinity<Real>, time};
-        if (settings_.ray_offset == RayOffset::error_bound) ray.origin = geometry_.spawn_origin(point, direction);
-        else ray.origin = point.position + (glm::dot(direction, normal) >= 0 ? normal : -normal) * epsilon_;
-        return ray;
+        return leaving_ray(geometry_, settings_.ray_offset, epsilon_, point, normal, direction, time);
     }
 
     RayTracer whitted_;

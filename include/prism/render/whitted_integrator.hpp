@@ -31,6 +31,21 @@ enum class RayOffset {
     scene_epsilon,
 };
 
+// The ray leaving `point` along `direction`, by `offset`; `normal` is the shading normal facing
+// the incoming ray (the scene-epsilon mode offsets along it, to the side the ray leaves by).
+// Both integrators spawn their secondary and shadow rays through it.
+template <Scalar Real, class Geometry>
+Ray<Real> leaving_ray(const Geometry& geometry, RayOffset offset, Real epsilon, const SurfacePoint<Real>& point,
+                      const Vec3<Real>& normal, const Vec3<Real>& direction, Real time) {
+    Ray<Real> ray{Vec3<Real>(0), direction, Real(0), infinity<Real>, time};
+    if (offset == RayOffset::error_bound) {
+        ray.origin = geometry.spawn_origin(point, direction);
+    } else {
+        ray.origin = point.position + (glm::dot(direction, normal) >= 0 ? normal : -normal) * epsilon;
+    }
+    return ray;
+}
+
 struct IntegratorSettings {
     int max_recursion_depth = 0;
     double shadow_ray_epsilon = 1e-3;  // RayOffset::scene_epsilon's offset
@@ -173,17 +188,9 @@ private:
         return depth == 0 ? background_ : Vec3<Real>(0);
     }
 
-    // The ray leaving `point` along `direction`; `normal` is the shading normal facing the
-    // incoming ray (the scene-epsilon mode offsets along it, to the side the ray leaves by).
     Ray<Real> leaving(const SurfacePoint<Real>& point, const Vec3<Real>& normal, const Vec3<Real>& direction,
                       Real time) const {
-        Ray<Real> ray{Vec3<Real>(0), direction, Real(0), infinity<Real>, time};
-        if (settings_.ray_offset == RayOffset::error_bound) {
-            ray.origin = geometry_.spawn_origin(point, direction);
-        } else {
-            ray.origin = point.position + (glm::dot(direction, normal) >= 0 ? normal : -normal) * epsilon_;
-        }
-        return ray;
+        return leaving_ray(geometry_, settings_.ray_offset, epsilon_, point, normal, direction, time);
     }
 
     Vec3<Real> direct_lighting(const SurfacePoint<Real>& point, const Vec3<Real>& normal, const Vec3<Real>& to_viewer,
