@@ -27,6 +27,11 @@ struct BvhBuildOptions {
     std::uint32_t max_leaf_size = 8;
     float traversal_cost = 1.0f;     // relative to one primitive test
     std::uint32_t parallel_threshold = 4096;  // subtrees at least this large build as tasks
+    // A node of at most max_leaf_size primitives becomes a leaf whatever SAH says of splitting
+    // it. The wide BVH asks for this: it collapses every such subtree into one leaf anyway, so
+    // the splits below it were work thrown away (a quarter to a third of the build). The leaf
+    // holds the same primitives either way, in the order the parent's partition left them.
+    bool leaf_at_max_size = false;
 };
 
 template <Scalar Real>
@@ -155,39 +160,68 @@ private:
         return node.is_leaf() ? 1 : 1 + std::max(depth_of(node.index), depth_of(node.index + 1));
     }
 
-    // A box as the builder reads it: four lanes per corner (the fourth unused), contiguous and in
-    // the order of primitive_indices, so every pass over a node reads one range instead of
-    // gathering boxes through the indices (a cache miss per primitive per level once the
-    // partitions have scrambled the order), and the compiler can take each corner's minimum or
-    // maximum as one 4-wide operation. The partitions permute boxes and indices together.
+    // Four lanes of Real, the builder's unit of work: a box corner (x, y, z and an unused
+    // fourth lane) or a centroid. Under GCC and Clang a vector type, whose `a < b ? a : b` is
+    // one SSE/AVX minimum with IEEE semantics (x86's minps returns its second operand on NaN or
+    // equality, as the ternary does), so every lane keeps the scalar expression's bits. Not
+    // simd::Pack: its select became an AVX-512 masked store into the bin, and a masked store
+    // cannot forward to the next load of that bin, which stalled every bin update. Values of
+    // this type are passed by reference only: returning a 32-byte vector by value warns
+    // (-Wpsabi) where AVX is not enabled.
+#if defined(__GNUC__) || defined(__clang__)
+    typedef Real Lanes __attribute__((vector_size(4 * sizeof(Real))));
+    static void keep_min(Lanes& into, const Lanes& x) { into = x < into ? x : into; }
+    static void keep_max(Lanes& into, const Lanes& x) { into = into < x ? x : into; }
+    static void half_sum(const Lanes& a, const Lanes& b, Lanes& out) { out = (a + b) * Real(0.5); }
+    static void shift_scale(const Lanes& x, const Lanes& shift, const Lanes& scale, Lanes& out) {
+        out = (x - shift) * scale;
+    }
+#else
+    using Lanes = std::array<Real, 4>;
+    static void keep_min(Lanes& into, const Lanes& x) {
+        for (int k = 0; k < 4; ++k) into[k] = x[k] < into[k] ? x[k] : into[k];
+    }
+    static void keep_max(Lanes& into, const Lanes& x) {
+        for (int k = 0; k < 4; ++k) into[k] = into[k] < x[k] ? x[k] : into[k];
+    }
+    static void half_sum(const Lanes& a, const Lanes& b, Lanes& out) {
+        for (int k = 0; k < 4; ++k) out[k] = (a[k] + b[k]) * Real(0.5);
+    }
+    static void shift_scale(const Lanes& x, const Lanes& shift, const Lanes& scale, Lanes& out) {
+        for (int k = 0; k < 4; ++k) out[k] = (x[k] - shift[k]) * scale[k];
+    }
+#endif
+
+    // A box as the builder reads it: four lanes per corner, contiguous and in the order of
+    // primitive_indices, so every pass over a node reads one range instead of gathering boxes
+    // through the indices (a cache miss per primitive per level once the partitions have
+    // scrambled the order), and each corner's minimum or maximum is one 4-wide operation. The
+    // partitions permute boxes and indices together.
     struct BuildBox {
-        std::array<Real, 4> min, max;
+        Lanes min, max;
 
         static BuildBox of(const Aabb<Real>& box) {
-            return {{box.min.x, box.min.y, box.min.z, Real(0)}, {box.max.x, box.max.y, box.max.z, Real(0)}};
+            BuildBox made;
+            for (int axis = 0; axis < 3; ++axis) {
+                made.min[axis] = box.min[axis];
+                made.max[axis] = box.max[axis];
+            }
+            made.min[3] = made.max[3] = Real(0);
+            return made;
         }
         Aabb<Real> aabb() const { return {{min[0], min[1], min[2]}, {max[0], max[1], max[2]}}; }
-        // As Aabb::centroid computes it, so bins and partitions see the same centroids.
-        Real centroid(int axis) const { return (min[axis] + max[axis]) * Real(0.5); }
-        Vec3<Real> centroid() const { return {centroid(0), centroid(1), centroid(2)}; }
-        // glm::min(min, other.min), lane by lane: the same operand order, so the same results.
-        void extend(const BuildBox& other) {
-            for (int k = 0; k < 4; ++k) {
-                min[k] = other.min[k] < min[k] ? other.min[k] : min[k];
-                max[k] = max[k] < other.max[k] ? other.max[k] : max[k];
-            }
+        // Each lane's (min + max) * 0.5, as Aabb::centroid computes it, so bins and partitions
+        // see the same centroids.
+        [[gnu::always_inline]] void centroid(Lanes& out) const { half_sum(min, max, out); }
+        // glm::min(min, other.min) and glm::max, lane by lane in the same operand order.
+        [[gnu::always_inline]] void extend(const BuildBox& other) {
+            keep_min(min, other.min);
+            keep_max(max, other.max);
         }
         // glm::min(min, point), as Aabb::extend(point) takes it.
-        void extend(const std::array<Real, 4>& point) {
-            for (int k = 0; k < 4; ++k) {
-                min[k] = point[k] < min[k] ? point[k] : min[k];
-                max[k] = max[k] < point[k] ? point[k] : max[k];
-            }
-        }
-        std::array<Real, 4> centroid_lanes() const {
-            std::array<Real, 4> c;
-            for (int k = 0; k < 4; ++k) c[k] = (min[k] + max[k]) * Real(0.5);
-            return c;
+        [[gnu::always_inline]] void extend(const Lanes& point) {
+            keep_min(min, point);
+            keep_max(max, point);
         }
         // Aabb::half_area's operations in its order, so the SAH costs keep their bits.
         Real half_area() const {
@@ -196,8 +230,12 @@ private:
             return x * y + y * z + z * x;
         }
         static BuildBox empty() {
-            return {{infinity<Real>, infinity<Real>, infinity<Real>, infinity<Real>},
-                    {-infinity<Real>, -infinity<Real>, -infinity<Real>, -infinity<Real>}};
+            BuildBox made;
+            for (int k = 0; k < 4; ++k) {
+                made.min[k] = infinity<Real>;
+                made.max[k] = -infinity<Real>;
+            }
+            return made;
         }
     };
 
@@ -258,6 +296,7 @@ private:
             const std::uint32_t count = end - begin;
             // Leave room on the traversal stack: past max_depth - 1, stop splitting.
             if (count <= 1 || depth >= max_depth - 2) return make_leaf(node, begin, end);
+            if (options.leaf_at_max_size && count <= options.max_leaf_size) return make_leaf(node, begin, end);
             const BuildBox* const range = boxes.data() + begin;
 
             const int bin_count = std::min(options.bin_count, max_bins);
@@ -269,15 +308,25 @@ private:
                 if (splittable[axis])
                     scale[axis] = Real(bin_count) / (centroid_bounds.max[axis] - centroid_bounds.min[axis]);
             }
-            const auto bin_of = [&](const BuildBox& box, int axis) {
-                return std::min(bin_count - 1, int((box.centroid(axis) - low[axis]) * scale[axis]));
+            Lanes low_lanes, scale_lanes;
+            for (int k = 0; k < 4; ++k) {
+                low_lanes[k] = low[k];
+                scale_lanes[k] = scale[k];
+            }
+            // Where a box's centroid falls, in bins, on every axis at once: the scalar
+            // (centroid - low) * scale in its order, lane by lane (one SIMD operation a step).
+            const auto bin_positions = [&](const Lanes& centroid, Lanes& position) __attribute__((always_inline)) {
+                shift_scale(centroid, low_lanes, scale_lanes, position);
             };
-            // The same bins on every axis at once, lane by lane (vectorised by the compiler). An
-            // axis that cannot be split puts everything in bin 0; so does a NaN centroid (an
-            // empty box, e.g. an instance of an empty mesh), which converts to INT_MIN on x86.
-            const auto bins_of = [&](const BuildBox& box) {
+            // The bins, lane by lane. An axis that cannot be split puts everything in bin 0; so
+            // does a NaN centroid (an empty box, e.g. an instance of an empty mesh), which
+            // converts to INT_MIN on x86.
+            const auto bins_of = [&](const BuildBox& box) __attribute__((always_inline)) {
+                Lanes centroid, position;
+                box.centroid(centroid);
+                bin_positions(centroid, position);
                 std::array<int, 4> bin;
-                for (int k = 0; k < 4; ++k) bin[k] = int((box.centroid(k) - low[k]) * scale[k]);
+                for (int k = 0; k < 4; ++k) bin[k] = int(position[k]);
                 for (int k = 0; k < 4; ++k) bin[k] = bin[k] < bin_count - 1 ? bin[k] : bin_count - 1;
                 for (int k = 0; k < 4; ++k) bin[k] = bin[k] > 0 ? bin[k] : 0;
                 return bin;
@@ -367,9 +416,12 @@ private:
                 // each box (the same minima and maxima Aabb::extend would find), indexed by
                 // side rather than chosen by a branch the data would mispredict.
                 std::array<BuildBox, 2> centroid_lanes{BuildBox::empty(), BuildBox::empty()};  // right, left
-                const auto goes_left = [&](const BuildBox& box) {
-                    const bool left = bin_of(box, best_axis) < best_split;
-                    centroid_lanes[left].extend(box.centroid_lanes());
+                const auto goes_left = [&](const BuildBox& box) __attribute__((always_inline)) {
+                    Lanes centroid, position;
+                    box.centroid(centroid);
+                    bin_positions(centroid, position);
+                    const bool left = std::min(bin_count - 1, int(position[best_axis])) < best_split;
+                    centroid_lanes[left].extend(centroid);
                     return left;
                 };
                 middle = begin + partition(begin, end, goes_left);

@@ -7,7 +7,7 @@
 // its range of primitive_indices to a callback.
 //
 // Leaves are sized for N-wide triangle packets: a binary subtree of at most N primitives becomes
-// one leaf, and every leaf's range starts at a multiple of N, padded up to the next multiple of
+// one leaf (the binary builder stops splitting there), and every leaf's range starts at a multiple of N, padded up to the next multiple of
 // N with repeats of its last primitive. A leaf callback still gets the true count; the padding
 // only lets packet k of a mesh be slots [k N, k N + N) (geometry/triangle_packets.hpp).
 #pragma once
@@ -54,6 +54,7 @@ public:
     // than a box test, so each gets a box of its own.
     static WideBvhTree build(std::span<const Aabb<Real>> boxes, BvhBuildOptions options = {.max_leaf_size = N}) {
         options.max_leaf_size = std::clamp<std::uint32_t>(options.max_leaf_size, 1, N);
+        options.leaf_at_max_size = true;  // the collapse would make such a subtree one leaf
         const BvhTree<Real> binary = BvhTree<Real>::build(boxes, options);
         WideBvhTree tree;
         if (boxes.empty()) return tree;
