@@ -593,6 +593,74 @@ TEST_CASE_TEMPLATE("BVH structure: a mesh, random boxes, one centroid, a geometr
     }
 }
 
+namespace {
+
+// The subtrees a wide collapse turns into leaves: each highest node over at most max_leaf_size
+// primitives, as its box and its primitives (sorted, as a set).
+template <class Real>
+struct SmallSubtree {
+    prism::Aabb<Real> bounds;
+    std::vector<std::uint32_t> primitives;
+    bool operator<(const SmallSubtree& other) const { return primitives < other.primitives; }
+};
+
+template <class Real>
+void collect_small_subtrees(const prism::BvhTree<Real>& tree, std::uint32_t index, std::uint32_t max_leaf_size,
+                            std::vector<SmallSubtree<Real>>& out, std::vector<std::uint32_t>* gathered = nullptr) {
+    const prism::BvhNode<Real>& node = tree.nodes()[index];
+    std::vector<std::uint32_t> primitives;
+    if (node.is_leaf()) {
+        const auto& order = tree.primitive_indices();
+        primitives.assign(order.begin() + node.index, order.begin() + node.index + node.count);
+    } else {
+        std::vector<SmallSubtree<Real>> below;
+        collect_small_subtrees(tree, node.index, max_leaf_size, below, &primitives);
+        collect_small_subtrees(tree, node.index + 1, max_leaf_size, below, &primitives);
+        if (primitives.size() > max_leaf_size) out.insert(out.end(), below.begin(), below.end());
+    }
+    if (gathered != nullptr) gathered->insert(gathered->end(), primitives.begin(), primitives.end());
+    if (primitives.size() <= max_leaf_size) {
+        std::sort(primitives.begin(), primitives.end());
+        out.push_back({node.bounds, std::move(primitives)});
+    }
+}
+
+}  // namespace
+
+TEST_CASE_TEMPLATE("BVH stopped at the leaf size: the leaves the full build's collapse would make", Real, float, double) {
+    // The wide BVH builds its binary tree with leaf_at_max_size: no node of at most
+    // max_leaf_size primitives is split. Its leaves must be exactly the full build's highest
+    // subtrees of that size, with the same boxes; only the order inside a leaf may differ.
+    std::vector<glm::dvec3> positions;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    perturbed_sphere(5, 11, positions, triangles);  // 20,480 triangles: above the parallel threshold
+    const auto boxes = triangle_boxes<Real>(positions, triangles);
+    for (const std::uint32_t max_leaf_size : {4u, 8u}) {
+        CAPTURE(max_leaf_size);
+        const auto full = prism::BvhTree<Real>::build(boxes, {.max_leaf_size = max_leaf_size});
+        const auto stopped = prism::BvhTree<Real>::build(boxes, {.max_leaf_size = max_leaf_size, .leaf_at_max_size = true});
+        check_structure(stopped, boxes, max_leaf_size);
+        CHECK(stopped.nodes().size() < full.nodes().size());
+        std::vector<SmallSubtree<Real>> expected, leaves;
+        collect_small_subtrees(full, 0, max_leaf_size, expected);
+        for (const auto& node : stopped.nodes()) {
+            if (!node.is_leaf()) continue;
+            std::vector<std::uint32_t> primitives(stopped.primitive_indices().begin() + node.index,
+                                                  stopped.primitive_indices().begin() + node.index + node.count);
+            std::sort(primitives.begin(), primitives.end());
+            leaves.push_back({node.bounds, std::move(primitives)});
+        }
+        std::sort(expected.begin(), expected.end());
+        std::sort(leaves.begin(), leaves.end());
+        REQUIRE(leaves.size() == expected.size());
+        std::size_t different = 0;
+        for (std::size_t i = 0; i < leaves.size(); ++i)
+            different += leaves[i].primitives != expected[i].primitives || leaves[i].bounds.min != expected[i].bounds.min ||
+                         leaves[i].bounds.max != expected[i].bounds.max;
+        CHECK(different == 0);
+    }
+}
+
 TEST_CASE_TEMPLATE("BVH on no primitives: an empty tree, an empty mesh, an empty scene", Real, float, double) {
     const auto tree = prism::BvhTree<Real>::build({});
     check_structure(tree, {}, 8);
