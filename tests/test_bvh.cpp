@@ -1009,6 +1009,20 @@ void check_wide_trees() {
         const std::vector<prism::Aabb<Real>> few(sphere_boxes.begin(), sphere_boxes.begin() + std::ptrdiff_t(count));
         check_wide_structure(prism::WideBvhTree<Real, N>::build(few), few);
     }
+    // The heuristic collapse: a leaf holds at most two packets, and nodes are nearly full (the
+    // largest-area collapse left the tiny-triangle dragon's 8-wide nodes with 4.3 children).
+    {
+        const auto tree = prism::WideBvhTree<Real, N>::build(sphere_boxes);
+        std::uint32_t largest = 0;
+        std::size_t children = 0;
+        for (const auto& node : tree.nodes())
+            for (int c = 0; c < N; ++c) {
+                largest = std::max(largest, node.count[c]);
+                children += node.bounds[0][c] <= node.bounds[3][c] ? 1 : 0;
+            }
+        CHECK(largest <= 2 * N);
+        CHECK(double(children) / double(tree.nodes().size()) > 0.8 * N);
+    }
     // Smaller leaves on request (a scene's top level asks for one instance per leaf); a larger
     // request is held to N, the width of the triangle packets.
     for (const std::uint32_t max_leaf_size : {1u, 3u}) {
