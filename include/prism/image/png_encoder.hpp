@@ -57,6 +57,7 @@ struct DeflatedBand {
 // clears about 260 kB, and fresh buffers are cleared and faulted in again, which took a third of
 // the encoding of hw1 simple.xml's image.
 struct BandScratch {
+    std::vector<std::uint8_t> row;  // a row's bytes before filtering
     std::vector<std::uint8_t> filtered;
     std::vector<std::uint8_t> deflated;
     z_stream stream{};
@@ -79,17 +80,21 @@ inline DeflatedBand deflate_band(const Image& image, int first, int last) {
     const std::size_t row = std::size_t(image.width) * 3;
     std::vector<std::uint8_t>& filtered = scratch.filtered;
     filtered.resize((row + 1) * std::size_t(last - first));
+    // Two straight passes a row, which GCC vectorises: the row's bytes, then their Sub filter.
+    // (One pass carrying the left pixel did not vectorise: a one-thread encoding of an 800 x 800
+    // test image took 15.8-16.0 ms with it, 12.7-14.4 ms with these, at a load of 9.) glm's vec3
+    // is three packed floats, so a row is 3 * width floats.
+    std::vector<std::uint8_t>& bytes = scratch.row;
+    bytes.resize(row);
     std::uint8_t* out = filtered.data();
     for (int y = first; y < last; ++y) {
-        const glm::vec3* pixels = image.pixels.data() + std::size_t(y) * std::size_t(image.width);
+        const float* channels = &image.pixels[std::size_t(y) * std::size_t(image.width)].x;
+        std::uint8_t* row_bytes = bytes.data();
+        for (std::size_t i = 0; i < row; ++i) row_bytes[i] = channel_to_8bit(channels[i]);
         *out++ = 1;  // Sub
-        std::array<std::uint8_t, 3> left{0, 0, 0};
-        for (int x = 0; x < image.width; ++x)
-            for (int c = 0; c < 3; ++c) {
-                const std::uint8_t value = channel_to_8bit(pixels[x][c]);
-                *out++ = std::uint8_t(value - left[std::size_t(c)]);
-                left[std::size_t(c)] = value;
-            }
+        for (std::size_t i = 0; i < std::min<std::size_t>(3, row); ++i) out[i] = row_bytes[i];
+        for (std::size_t i = 3; i < row; ++i) out[i] = std::uint8_t(row_bytes[i] - row_bytes[i - 3]);
+        out += row;
     }
     band.size = filtered.size();
     band.adler = adler32(adler32(0L, Z_NULL, 0), filtered.data(), uInt(filtered.size()));
