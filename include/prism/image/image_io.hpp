@@ -243,7 +243,8 @@ inline Image decode_exr(std::string_view bytes, const std::filesystem::path& pat
     image.width = exr.width;
     image.height = exr.height;
     check_image_size(path, image.width, image.height, max_pixels);
-    image.pixels.resize(std::size_t(image.width) * std::size_t(image.height));
+    // Black where no tile lands (the film's allocator leaves resized pixels unset).
+    image.pixels.assign(std::size_t(image.width) * std::size_t(image.height), glm::vec3(0.0f));
     const auto store = [&](float* const* planes, int width, int height, int x0, int y0) {
         for (int y = 0; y < height; ++y)
             for (int x = 0; x < width; ++x) {
