@@ -97,6 +97,22 @@ TEST_CASE("PNG and PPM round trips hold exactly the to_8bit values") {
     }
 }
 
+TEST_CASE("the film is black when made, small or in huge pages, and copies whole") {
+    for (const int side : {3, 1024}) {  // 108 bytes, and 12 MB: FilmAllocator's huge-page path
+        CAPTURE(side);
+        prism::Image image(side, side);
+        REQUIRE(image.pixels.size() == std::size_t(side) * std::size_t(side));
+        std::size_t lit = 0;
+        for (const auto& pixel : image.pixels) lit += pixel != glm::vec3(0.0f);
+        CHECK(lit == 0);
+        image.pixels.back() = glm::vec3(1.0f, 2.0f, 3.0f);
+        const prism::Image copy = image;
+        CHECK(copy.pixels == image.pixels);
+        prism::Image unfilled(side, 2, prism::Image::Unfilled{});
+        CHECK(unfilled.pixels.size() == std::size_t(side) * 2);
+    }
+}
+
 TEST_CASE("a PNG of many bands decodes to the to_8bit values, in the same bytes at 1 and 2 threads") {
     // 601 x 500: rows of 1,803 bytes, so png_band_rows gives 54 rows a band and ten bands, the
     // last one short; noise-like values, so deflate's matches cross the band boundaries' rows.
