@@ -18,7 +18,7 @@
 namespace prism {
 
 // The film's storage. A film of 2 MB or more is asked for in transparent huge pages: an
-// 800 x 800 film is 7.7 MB, whose 1,876 page faults in 4 kB pages cost 2.1-2.2 ms on this
+// 800 x 800 film is 7.7 MB, whose 1,876 page faults in 4 kB pages cost 2.1-2.25 ms on this
 // machine's kernel before the render could start, against 0.35-0.45 ms in 2 MB pages (one
 // process, first touch; where the kernel has no huge pages to give, madvise changes nothing).
 // Elements are default-initialised, so a film whose every pixel the renderer writes is not

@@ -36,7 +36,7 @@ inline std::uint8_t channel_to_8bit(float value) {
 namespace detail {
 
 // zlib's fastest level. Against the default level (6) on five course images (800 x 800 to
-// 1024 x 1024) it takes 0.2-0.4 of the time for files 1.3-1.6 times as large (mirror_room:
+// 1024 x 1024) it takes 0.2-0.4 of the time for files 1.3-1.9 times as large (mirror_room:
 // 45.5 ms and 197 kB at level 6, 9.6 ms and 297 kB at level 1); the course's images are
 // 80-300 kB either way, and the pixels are the same.
 inline constexpr int png_deflate_level = Z_BEST_SPEED;
