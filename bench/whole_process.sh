@@ -6,7 +6,11 @@
 # (cmp, byte for byte). Used for bench/RESULTS.md ("Whole renders").
 #
 #   bash bench/whole_process.sh OLD_PRISM NEW_PRISM [--rounds N] [--threads T] [--shared DIR]
-#                               [--topics hw1,hw2] [--extra PATH]... [-- NEW_PRISM_OPTIONS...]
+#                               [--topics hw1,hw2] [--extra PATH]... [--base BASE_PRISM]
+#                               [-- NEW_PRISM_OPTIONS...]
+#
+# --base adds a third binary to every round (a branch's base, say), with its median time, the
+# median of the per-round ratios new/base and whether new wrote the same pixels as it.
 #
 # Scenes: every distinct hw1/hw2 path of MANIFEST.tsv (default) and each --extra path (relative
 # to the course folder). Scenes either binary refuses are listed as such and skipped.
@@ -14,7 +18,7 @@ set -euo pipefail
 
 old=$1 new=$2
 shift 2
-rounds=3 threads=2 shared=../shared topics=hw1,hw2
+rounds=3 threads=2 shared=../shared topics=hw1,hw2 base=
 extras=()
 new_options=()
 while [[ $# -gt 0 ]]; do
@@ -24,6 +28,7 @@ while [[ $# -gt 0 ]]; do
     --shared) shared=$2; shift 2 ;;
     --topics) topics=$2; shift 2 ;;
     --extra) extras+=("$2"); shift 2 ;;
+    --base) base=$2; shift 2 ;;
     --) shift; new_options=("$@"); break ;;
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
@@ -90,17 +95,27 @@ EOF
 }
 median() { sort -g | awk '{ a[NR] = $1 } END { print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2 }'; }
 
-printf '%s\t%s\t%s\t%s\t%s\n' scene old_s new_s new/old same_images
+if [[ -n $base ]]; then
+  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' scene old_s new_s new/old same_images base_s new/base same_as_base
+else
+  printf '%s\t%s\t%s\t%s\t%s\n' scene old_s new_s new/old same_images
+fi
 for scene in "${scenes[@]}"; do
-  old_times=() new_times=() ratios=() refused=
+  old_times=() new_times=() ratios=() base_times=() base_ratios=() refused=
   for ((round = 0; round < rounds; ++round)); do
+    t_base=0
     if ((round % 2 == 0)); then
-      t_old=$(run "$old" "$work/old" "$scene"); t_new=$(run "$new" "$work/new" "$scene" "${new_options[@]}")
+      t_old=$(run "$old" "$work/old" "$scene")
+      [[ -n $base ]] && t_base=$(run "$base" "$work/base" "$scene")
+      t_new=$(run "$new" "$work/new" "$scene" "${new_options[@]}")
     else
-      t_new=$(run "$new" "$work/new" "$scene" "${new_options[@]}"); t_old=$(run "$old" "$work/old" "$scene")
+      t_new=$(run "$new" "$work/new" "$scene" "${new_options[@]}")
+      [[ -n $base ]] && t_base=$(run "$base" "$work/base" "$scene")
+      t_old=$(run "$old" "$work/old" "$scene")
     fi
-    if [[ $t_old == refused || $t_new == refused ]]; then refused=yes; break; fi
+    if [[ $t_old == refused || $t_new == refused || $t_base == refused ]]; then refused=yes; break; fi
     old_times+=("$t_old") new_times+=("$t_new") ratios+=("$(echo "$t_new / $t_old" | bc -l)")
+    if [[ -n $base ]]; then base_times+=("$t_base") base_ratios+=("$(echo "$t_new / $t_base" | bc -l)"); fi
   done
   if [[ -n $refused ]]; then
     printf '%s\trefused\n' "$scene"
@@ -110,7 +125,16 @@ for scene in "${scenes[@]}"; do
   for image in "$work"/old/*; do
     same_pixels "$image" "$work/new/$(basename "$image")" || same=no
   done
-  printf '%s\t%.3f\t%.3f\t%.3f\t%s\n' "$scene" \
+  printf '%s\t%.3f\t%.3f\t%.3f\t%s' "$scene" \
     "$(printf '%s\n' "${old_times[@]}" | median)" "$(printf '%s\n' "${new_times[@]}" | median)" \
     "$(printf '%s\n' "${ratios[@]}" | median)" "$same"
+  if [[ -n $base ]]; then
+    same_base=yes
+    for image in "$work"/base/*; do
+      same_pixels "$image" "$work/new/$(basename "$image")" || same_base=no
+    done
+    printf '\t%.3f\t%.3f\t%s' "$(printf '%s\n' "${base_times[@]}" | median)" \
+      "$(printf '%s\n' "${base_ratios[@]}" | median)" "$same_base"
+  fi
+  printf '\n'
 done

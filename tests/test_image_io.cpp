@@ -5,13 +5,17 @@
 #include <prism/image/image_io.hpp>
 
 #include <doctest/doctest.h>
+#include <tbb/global_control.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <string>
+#include <vector>
 
 #ifndef PRISM_SHARED_DIR
 #define PRISM_SHARED_DIR "../shared"
@@ -91,6 +95,53 @@ TEST_CASE("PNG and PPM round trips hold exactly the to_8bit values") {
             for (int c = 0; c < 3; ++c) CHECK(read.pixels[i][c] == float(expected[3 * i + std::size_t(c)]));
         CHECK(folder.entry_count() == 2);  // the folder and the file: no temporary left behind
     }
+}
+
+TEST_CASE("the film is black when made, small or in huge pages, and copies whole") {
+    for (const int side : {3, 1024}) {  // 108 bytes, and 12 MB: FilmAllocator's huge-page path
+        CAPTURE(side);
+        prism::Image image(side, side);
+        REQUIRE(image.pixels.size() == std::size_t(side) * std::size_t(side));
+        std::size_t lit = 0;
+        for (const auto& pixel : image.pixels) lit += pixel != glm::vec3(0.0f);
+        CHECK(lit == 0);
+        image.pixels.back() = glm::vec3(1.0f, 2.0f, 3.0f);
+        const prism::Image copy = image;
+        CHECK(copy.pixels == image.pixels);
+        prism::Image unfilled(side, 2, prism::Image::Unfilled{});
+        CHECK(unfilled.pixels.size() == std::size_t(side) * 2);
+    }
+}
+
+TEST_CASE("a PNG of many bands decodes to the to_8bit values, in the same bytes at 1 and 2 threads") {
+    // 601 x 500: rows of 1,803 bytes, so png_band_rows gives 54 rows a band and ten bands, the
+    // last one short; noise-like values, so deflate's matches cross the band boundaries' rows.
+    prism::Image image(601, 500);
+    std::uint32_t state = 12345u;
+    for (auto& pixel : image.pixels)
+        for (int c = 0; c < 3; ++c) {
+            state = state * 1664525u + 1013904223u;
+            pixel[c] = float(state >> 20) / 12.0f - 20.0f;  // -20 .. 321: both clamps are taken
+        }
+    REQUIRE(prism::detail::png_band_rows(601 * 3) < image.height / 4);
+    std::vector<std::vector<std::uint8_t>> files;
+    for (int threads : {1, 2}) {
+        const tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+        const auto file = prism::encode_png(image);
+        REQUIRE(file.has_value());
+        files.push_back(*file);
+    }
+    CHECK(files[0] == files[1]);
+    ScratchFolder folder("bands");
+    const fs::path path = folder.path / "bands.png";
+    prism::write_image(path, image);
+    std::ifstream stream(path, std::ios::binary);
+    const std::vector<std::uint8_t> written((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+    CHECK(written == files[0]);
+    const prism::Image read = prism::read_image(path);
+    REQUIRE(read.width == image.width);
+    REQUIRE(read.height == image.height);
+    CHECK(prism::to_8bit(read) == prism::to_8bit(image));
 }
 
 TEST_CASE("EXR round trip is bit-identical, in B,G,R channel order") {

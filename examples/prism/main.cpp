@@ -12,6 +12,8 @@
 #include <prism/render/progress.hpp>
 #include <prism/render/render_scene.hpp>
 
+#include <tbb/global_control.h>
+
 #include <atomic>
 #include <charconv>
 #include <csignal>
@@ -145,6 +147,10 @@ int main(int argc, char** argv) {
     std::ostringstream silent;
     std::ostream& log = arguments.quiet ? static_cast<std::ostream&>(silent) : std::cout;
     std::signal(SIGINT, on_interrupt);
+    // --threads bounds the image encoding too (png_encoder.hpp), not only the render.
+    std::optional<tbb::global_control> parallelism;
+    if (arguments.options.threads > 0)
+        parallelism.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(arguments.options.threads));
     try {
         const prism::scene::Scene scene = prism::io::load_scene(arguments.scene, arguments.load);
         if (interrupted.load()) throw Interrupted{};

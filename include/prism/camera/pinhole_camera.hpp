@@ -33,7 +33,7 @@ public:
     // A unit-direction ray through the continuous image position (x, y), x in [0, width) from
     // the left, y in [0, height) from the top; pixel centres are at +0.5.
     Ray<Real> ray(Real x, Real y) const {
-        return {origin_, glm::normalize(top_left_ + x * step_u_ + y * step_v_), Real(0), infinity<Real>};
+        return {origin_, unit_vector(top_left_ + x * step_u_ + y * step_v_), Real(0), infinity<Real>};
     }
 
     // The camera's frame: position, the image plane's right (u) and up (v) axes, and the unit

@@ -30,7 +30,7 @@ public:
         if (aperture_ > 0) {
             const Vec3<Real> focus = ray.origin + ray.direction * (focus_distance_ / glm::dot(ray.direction, pinhole_.forward()));
             ray.origin += aperture_ * ((lens.x - Real(0.5)) * pinhole_.right() + (lens.y - Real(0.5)) * pinhole_.up());
-            ray.direction = glm::normalize(focus - ray.origin);
+            ray.direction = unit_vector(focus - ray.origin);
         }
         return ray;
     }

@@ -5,16 +5,15 @@
 
 #include <prism/image/decoder_guard.hpp>
 #include <prism/image/image.hpp>
+#include <prism/image/png_encoder.hpp>
 #include <prism/io/limits.hpp>
 #include <prism/io/load_error.hpp>
 
 #include <stb_image.h>
 #include <stb_image_write.h>
 #include <tinyexr.h>
-#include <zlib.h>
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <cctype>
 #include <cmath>
@@ -23,6 +22,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -33,20 +33,13 @@
 
 namespace prism {
 
-// The course's LDR conversion when a scene declares no tone mapping: radiance is already on the
-// 0..255 scale, so each channel is clamped and truncated, as the course's own renderer does (its
-// expected images sit 0.47 levels below rounded ones on average: measured on bunny_with_plane,
-// 1024x1024, where everything else matches to within 1/255). NaN becomes 0 (the comparison
-// below is false for NaN), so a broken pixel shows as black instead of undefined behaviour.
-// Interleaved RGB, row-major from the top-left pixel, as stbi_write_png expects.
+// The course's LDR conversion of every channel (channel_to_8bit): interleaved RGB, row-major
+// from the top-left pixel.
 inline std::vector<std::uint8_t> to_8bit(const Image& image) {
     std::vector<std::uint8_t> bytes(image.pixels.size() * 3);
     std::size_t i = 0;
     for (const glm::vec3& pixel : image.pixels)
-        for (int c = 0; c < 3; ++c) {
-            const float value = pixel[c] > 0.0f ? std::min(pixel[c], 255.0f) : 0.0f;
-            bytes[i++] = static_cast<std::uint8_t>(value);
-        }
+        for (int c = 0; c < 3; ++c) bytes[i++] = channel_to_8bit(pixel[c]);
     return bytes;
 }
 
@@ -130,48 +123,13 @@ inline void write_ppm(const std::filesystem::path& path, const Image& image, con
     if (!out) throw io::LoadError(shown, "ImageName", "cannot write the PPM file");
 }
 
-// An 8-bit RGB PNG (PNG specification, ISO/IEC 15948): every row with the Sub filter, one
-// zlib stream at zlib's default level. stb's writer tries five filters per row and compresses
-// with its own deflate: 214 ms for an 800 x 800 course image here, against 54 ms for this (and
-// 29 kB instead of 38 kB); on the small hw1 scenes that was a fifth of the whole process.
-inline bool write_png(const std::filesystem::path& path, const std::vector<std::uint8_t>& rgb, int width,
-                      int height) {
-    const std::size_t row = std::size_t(width) * 3;
-    std::vector<std::uint8_t> filtered;
-    filtered.reserve((row + 1) * std::size_t(height));
-    for (int y = 0; y < height; ++y) {
-        const std::uint8_t* line = rgb.data() + std::size_t(y) * row;
-        filtered.push_back(1);  // Sub: each byte minus the byte one pixel to its left
-        for (std::size_t i = 0; i < row; ++i) filtered.push_back(std::uint8_t(line[i] - (i >= 3 ? line[i - 3] : 0)));
-    }
-    uLongf compressed_size = compressBound(uLong(filtered.size()));
-    std::vector<std::uint8_t> compressed(compressed_size);
-    if (compress2(compressed.data(), &compressed_size, filtered.data(), uLong(filtered.size()), Z_DEFAULT_COMPRESSION) !=
-        Z_OK)
-        return false;
-    compressed.resize(compressed_size);
-
+// The PNG (png_encoder.hpp) written whole.
+inline bool write_png(const std::filesystem::path& path, const Image& image) {
+    const std::optional<std::vector<std::uint8_t>> file = encode_png(image);
+    if (!file) return false;
     std::ofstream out(path, std::ios::binary);
-    const auto put32 = [&](std::uint32_t value) {
-        const std::array<char, 4> bytes{char(value >> 24), char(value >> 16), char(value >> 8), char(value)};
-        out.write(bytes.data(), 4);
-    };
-    const auto chunk = [&](const char* type, const std::uint8_t* data, std::size_t size) {
-        put32(std::uint32_t(size));
-        out.write(type, 4);
-        out.write(reinterpret_cast<const char*>(data), std::streamsize(size));
-        uLong crc = crc32(0L, reinterpret_cast<const Bytef*>(type), 4);
-        if (size > 0) crc = crc32(crc, data, uInt(size));  // (a null buffer would restart the crc)
-        put32(std::uint32_t(crc));
-    };
-    out.write("\x89PNG\r\n\x1a\n", 8);
-    const std::array<std::uint8_t, 13> header{
-        std::uint8_t(width >> 24), std::uint8_t(width >> 16), std::uint8_t(width >> 8), std::uint8_t(width),
-        std::uint8_t(height >> 24), std::uint8_t(height >> 16), std::uint8_t(height >> 8), std::uint8_t(height),
-        8, 2, 0, 0, 0};  // 8 bits, RGB, deflate, adaptive filtering, no interlace
-    chunk("IHDR", header.data(), header.size());
-    chunk("IDAT", compressed.data(), compressed.size());
-    chunk("IEND", nullptr, 0);
+    out.write(reinterpret_cast<const char*>(file->data()), std::streamsize(file->size()));
+    out.close();
     return bool(out);
 }
 
@@ -197,8 +155,7 @@ inline void write_image(const std::filesystem::path& path, const Image& image) {
     const std::filesystem::path temporary = detail::temporary_sibling(path);
     try {
         if (extension == ".png") {
-            const std::vector<std::uint8_t> bytes = to_8bit(image);
-            if (!detail::write_png(temporary, bytes, image.width, image.height))
+            if (!detail::write_png(temporary, image))
                 throw io::LoadError(path, "ImageName", "cannot write the PNG file");
         } else if (extension == ".ppm") {
             detail::write_ppm(temporary, image, path);
@@ -286,7 +243,8 @@ inline Image decode_exr(std::string_view bytes, const std::filesystem::path& pat
     image.width = exr.width;
     image.height = exr.height;
     check_image_size(path, image.width, image.height, max_pixels);
-    image.pixels.resize(std::size_t(image.width) * std::size_t(image.height));
+    // Black where no tile lands (the film's allocator leaves resized pixels unset).
+    image.pixels.assign(std::size_t(image.width) * std::size_t(image.height), glm::vec3(0.0f));
     const auto store = [&](float* const* planes, int width, int height, int x0, int y0) {
         for (int y = 0; y < height; ++y)
             for (int x = 0; x < width; ++x) {

@@ -88,7 +88,7 @@ public:
                 const auto chosen = distribution_->sample(u);
                 const Real jacobian = map_.jacobian(chosen.point);
                 if (!(jacobian > 0)) return result;  // a pole or the probe's rim: no solid angle
-                result.direction = glm::normalize(map_.direction(chosen.point));
+                result.direction = unit_vector(map_.direction(chosen.point));
                 density = chosen.pdf / jacobian;
                 break;
             }

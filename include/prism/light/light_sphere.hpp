@@ -119,7 +119,7 @@ struct LightSphere {
         const Real distance = std::sqrt(distance_squared);
         if (!(distance > 0)) return {Vec3<Real>(0, 0, 1), Real(0), Vec3<Real>(0), Real(0)};
         const Vec3<Real> direction = to_light / distance;
-        const Vec3<Real> normal = glm::normalize(normal_to_world * (point_object - center));
+        const Vec3<Real> normal = unit_vector(normal_to_world * (point_object - center));
         const Real cos_light = std::abs(glm::dot(normal, direction));
         if (!(cos_light > 0)) return {direction, distance, Vec3<Real>(0), Real(0)};
         const Real density = area_density(from_object, point_object, cone_density) * distance_squared / cos_light;

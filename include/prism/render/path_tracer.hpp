@@ -209,7 +209,7 @@ private:
         const Real cos_transmitted = std::sqrt(1 - sin2_transmitted);
         const Real fresnel = fresnel_dielectric(cos_incident, cos_transmitted, n1, n2);
         if (random.uniform<Real>() < fresnel) return reflected;
-        Vec3<Real> transmitted = glm::normalize(ratio * d + (ratio * cos_incident - cos_transmitted) * normal);
+        Vec3<Real> transmitted = unit_vector(ratio * d + (ratio * cos_incident - cos_transmitted) * normal);
         if (material.roughness > 0) transmitted = perturb(transmitted, material.roughness, random.uniform2<Real>());
         if (material.transparency != Vec3<Real>(0)) throughput *= material.transparency;
         return transmitted;
@@ -246,7 +246,7 @@ private:
             Ray<Real> shadow = leaving(point, normal, sample.direction, point.time);
             if (!std::isinf(sample.distance)) {
                 const Vec3<Real> target = point.position + sample.direction * sample.distance;
-                shadow.direction = glm::normalize(target - shadow.origin);
+                shadow.direction = unit_vector(target - shadow.origin);
                 // An object light's own surface is at the far end: stop short of it.
                 shadow.t_max = glm::length(target - shadow.origin) * (1 - Real(1e-4));
             }

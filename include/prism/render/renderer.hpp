@@ -70,7 +70,7 @@ public:
         check_image(camera, width, height);
         const ThinLensCamera<Real> lens(camera, width, height);
         const int count = std::max(1, camera.num_samples);
-        Image image(width, height);
+        Image image(width, height, Image::Unfilled{});  // every pixel is written below
         tbb::parallel_for(tbb::blocked_range2d<int>(0, height, tile_size, 0, width, tile_size),
                           [&](const tbb::blocked_range2d<int>& tile) {
                               std::vector<CameraSample<Real>> samples;

@@ -84,9 +84,9 @@ Vec3<Real> perturb(const Vec3<Real>& direction, Real roughness, const Vec2<Real>
     if (magnitude.x <= magnitude.y && magnitude.x <= magnitude.z) helper.x = 1;
     else if (magnitude.y <= magnitude.z) helper.y = 1;
     else helper.z = 1;
-    const Vec3<Real> u = glm::normalize(glm::cross(helper, direction));
+    const Vec3<Real> u = unit_vector(glm::cross(helper, direction));
     const Vec3<Real> v = glm::cross(direction, u);
-    return glm::normalize(direction + roughness * ((sample.x - Real(0.5)) * u + (sample.y - Real(0.5)) * v));
+    return unit_vector(direction + roughness * ((sample.x - Real(0.5)) * u + (sample.y - Real(0.5)) * v));
 }
 
 template <Scalar Real, class Geometry, class LightSetT, class Textures = NoTextures<Real>,
@@ -207,7 +207,7 @@ private:
             // holds a light: 20.3 dB with a per-pixel coin flip, 64.5 dB consistent).
             Ray<Real> shadow = leaving(point, normal, sample.direction, point.time);
             if (!std::isinf(sample.distance))
-                shadow.direction = glm::normalize(position + sample.direction * sample.distance - shadow.origin);
+                shadow.direction = unit_vector(position + sample.direction * sample.distance - shadow.origin);
             shadow.t_max = sample.distance;
             // An object light's own surface is at the far end and is geometry: stop short of it,
             // as the path tracer does, or the light shadows itself (every point black, but for
@@ -220,7 +220,7 @@ private:
                 return;
             }
             // No BRDF: hw1-hw5's Blinn-Phong, kept in this form so their images stay bit-identical.
-            const Vec3<Real> half_vector = glm::normalize(sample.direction + to_viewer);
+            const Vec3<Real> half_vector = unit_vector(sample.direction + to_viewer);
             const Real cos_half = std::max(glm::dot(normal, half_vector), Real(0));
             color += (material.diffuse * cos_light + material.specular * std::pow(cos_half, material.phong_exponent)) *
                      sample.radiance;
@@ -238,7 +238,7 @@ private:
         if (sin2_transmitted >= 1) return trace(reflection, depth + 1, path, travelled);  // total internal reflection
         const Real cos_transmitted = std::sqrt(1 - sin2_transmitted);
         const Real fresnel = fresnel_dielectric(cos_incident, cos_transmitted, n1, n2);
-        Vec3<Real> transmitted = glm::normalize(ratio * d + (ratio * cos_incident - cos_transmitted) * normal);
+        Vec3<Real> transmitted = unit_vector(ratio * d + (ratio * cos_incident - cos_transmitted) * normal);
         Random& random = path.random;
         if (material.roughness > 0) transmitted = perturb(transmitted, material.roughness, random.uniform2<Real>());
         const Ray<Real> refraction = leaving(point, normal, transmitted, reflection.time);

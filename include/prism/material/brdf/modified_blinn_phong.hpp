@@ -21,7 +21,7 @@ struct ModifiedBlinnPhong {
     Vec3<Real> evaluate(const Vec3<Real>& kd, const Vec3<Real>& ks, const Vec3<Real>& n, const Vec3<Real>& wi,
                         const Vec3<Real>& wo) const {
         if (glm::dot(n, wi) <= 0) return Vec3<Real>(0);
-        const Vec3<Real> half = glm::normalize(wi + wo);
+        const Vec3<Real> half = unit_vector(wi + wo);
         const Real specular = std::pow(std::max(glm::dot(n, half), Real(0)), exponent);
         if (!normalized) return kd + ks * specular;
         return kd / pi<Real> + ks * ((exponent + 8) / (8 * pi<Real>) * specular);

@@ -19,7 +19,7 @@ struct OriginalBlinnPhong {
                         const Vec3<Real>& wo) const {
         const Real cos_incident = glm::dot(n, wi);
         if (cos_incident <= 0) return Vec3<Real>(0);
-        const Vec3<Real> half = glm::normalize(wi + wo);
+        const Vec3<Real> half = unit_vector(wi + wo);
         const Real cos_alpha = std::max(glm::dot(n, half), Real(0));
         return kd + ks * (std::pow(cos_alpha, exponent) / cos_incident);
     }

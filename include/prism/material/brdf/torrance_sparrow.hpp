@@ -30,7 +30,7 @@ struct TorranceSparrow {
         const Real cos_incident = glm::dot(n, wi);
         const Real cos_outgoing = glm::dot(n, wo);
         if (cos_incident <= 0 || cos_outgoing <= 0) return Vec3<Real>(0);
-        const Vec3<Real> half = glm::normalize(wi + wo);
+        const Vec3<Real> half = unit_vector(wi + wo);
         const Real cos_alpha = std::max(glm::dot(n, half), Real(0));
         const Real cos_beta = std::max(glm::dot(wo, half), Real(0));
         const Real distribution = (exponent + 2) / (2 * pi<Real>) * std::pow(cos_alpha, exponent);
