@@ -17,8 +17,11 @@
 #include <prism/geometry/triangle_mesh.hpp>
 #include <prism/scene/scene.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
+#include <span>
+#include <type_traits>
 #include <vector>
 
 namespace prism {
@@ -58,9 +61,12 @@ public:
     using Index = typename Policy::template Index<Real>;
 
     explicit SceneGeometry(const scene::Scene& scene) {
+        const std::vector<bool> merged = merged_meshes(scene);
         meshes_.reserve(scene.meshes.size());
-        for (const auto& mesh : scene.meshes) {
-            meshes_.emplace_back(mesh);
+        for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
+            const scene::Mesh& mesh = scene.meshes[m];
+            if (merged[m]) meshes_.emplace_back(mesh, typename Mesh::ShadingOnly{});
+            else meshes_.emplace_back(mesh);
             add_instance(Kind::mesh, std::uint32_t(meshes_.size() - 1), mesh.material, mesh.transform,
                          meshes_.back().bounds(), mesh.textures, mesh.motion);
             emitted_.emplace_back(mesh.radiance);
@@ -84,9 +90,31 @@ public:
             plane_materials_.push_back(std::uint32_t(plane.material));
             plane_textures_.push_back(add_texture_list(plane.textures));
         }
+        // One index per culling class over the merged meshes (flat ones are culled under
+        // flat_triangles, smooth ones never), the instance of mesh m being object m.
+        for (const bool smooth : {false, true}) {
+            WorldMeshes group;
+            group.smooth = smooth;
+            std::vector<const scene::Mesh*> parts;
+            std::uint32_t triangles = 0;
+            for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
+                if (!merged[m] || meshes_[m].smooth() != smooth) continue;
+                parts.push_back(&scene.meshes[m]);
+                group.objects.push_back(std::uint32_t(m));
+                group.first_triangle.push_back(triangles);
+                triangles += std::uint32_t(scene.meshes[m].triangles.size());
+            }
+            if (parts.empty()) continue;
+            group.index.emplace(std::span<const scene::Mesh* const>(parts));
+            world_meshes_.push_back(std::move(group));
+        }
         std::vector<Aabb<Real>> boxes;
-        boxes.reserve(instances_.size());
-        for (const auto& instance : instances_) boxes.push_back(instance.world_bounds);
+        for (std::uint32_t object = 0; object < instances_.size(); ++object) {
+            bounds_.extend(instances_[object].world_bounds);
+            if (object < merged.size() && merged[object]) continue;
+            top_objects_.push_back(object);
+            boxes.push_back(instances_[object].world_bounds);
+        }
         // One instance per leaf where the index takes the option: testing an instance (a
         // transform, then its mesh's own BVH or its sphere) costs far more than the box test
         // that could skip it. With the wide BVH's leaves of up to 8, a scene of a few instances
@@ -105,12 +133,20 @@ public:
             if (instance.kind == Kind::mesh) total += meshes_[instance.shape].triangle_count();
         return total;
     }
-    Aabb<Real> bounds() const { return top_.bounds(); }
-    // The indices of both levels and the triangles their leaves test (bench/scaling_bench.cpp).
+    Aabb<Real> bounds() const { return bounds_; }
+    // The indices of both levels, the merged world-space index, and the triangles their leaves
+    // test or shading reads (bench/scaling_bench.cpp).
     std::size_t accelerator_bytes() const {
         std::size_t total = top_.memory_bytes();
         for (const auto& mesh : meshes_) total += mesh.accelerator_bytes();
+        for (const auto& group : world_meshes_) total += group.index->accelerator_bytes();
         return total;
+    }
+    // How many meshes share one world-space index instead of a top-level entry each.
+    std::size_t merged_mesh_count() const {
+        std::size_t count = 0;
+        for (const auto& group : world_meshes_) count += group.objects.size();
+        return count;
     }
 
     // The radiance object `object` (Hit::object) emits from its surface: a LightMesh's or
@@ -122,14 +158,29 @@ public:
     // (geometry/backface_culling.hpp).
     template <BackfaceCulling Culling = BackfaceCulling::none>
     bool intersect(Ray<Real>& ray, Hit<Real>& hit) const {
-        bool found = false;
-        const auto& order = top_.primitive_indices();
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;  // made when the ray first enters a mesh
+        // The merged world-space meshes first: their hit lowers t_max before the top level
+        // tests any box.
+        bool found = false;
+        for (const WorldMeshes& group : world_meshes_) {
+            if (!world_triangle_ray) world_triangle_ray.emplace(ray);
+            const bool cull =
+                Culling == BackfaceCulling::all || (Culling == BackfaceCulling::flat_triangles && !group.smooth);
+            const Mesh& index = *group.index;
+            const bool group_hit = cull ? index.template intersect<true>(ray, traversal_ray, *world_triangle_ray, ray.t_max, hit)
+                                        : index.template intersect<false>(ray, traversal_ray, *world_triangle_ray, ray.t_max, hit);
+            if (group_hit) {
+                group.attribute(index.source_triangle(hit.primitive), hit);
+                found = true;
+            }
+        }
+        if (top_objects_.empty()) return intersect_planes<Culling>(ray, hit) || found;
+        const auto& order = top_.primitive_indices();
         top_.traverse_closest(traversal_ray, ray.t_min, ray.t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_max) {
             bool leaf_hit = false;
             for (std::uint32_t i = first; i < first + count; ++i) {
-                const std::uint32_t object = order[i];
+                const std::uint32_t object = top_objects_[order[i]];
                 if (intersect_instance<Culling>(instances_[object], ray, traversal_ray, world_triangle_ray, t_max, hit)) {
                     hit.object = object;
                     leaf_hit = true;
@@ -162,13 +213,19 @@ public:
 
     // Whether anything lies in (ray.t_min, ray.t_max).
     bool occluded(const Ray<Real>& ray) const {
-        const auto& order = top_.primitive_indices();
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;
+        for (const WorldMeshes& group : world_meshes_) {
+            if (!world_triangle_ray) world_triangle_ray.emplace(ray);
+            if (group.index->occluded(ray, traversal_ray, *world_triangle_ray, ray.t_max)) return true;
+        }
+        const auto& order = top_.primitive_indices();
         const bool blocked =
+            !top_objects_.empty() &&
             top_.traverse_any(traversal_ray, ray.t_min, ray.t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_max) {
                 for (std::uint32_t i = first; i < first + count; ++i)
-                    if (occludes(instances_[order[i]], ray, traversal_ray, world_triangle_ray, t_max)) return true;
+                    if (occludes(instances_[top_objects_[order[i]]], ray, traversal_ray, world_triangle_ray, t_max))
+                        return true;
                 return false;
             });
         return blocked || occluded_by_planes(ray);
@@ -331,6 +388,24 @@ private:
         }
     };
 
+    // The meshes that share the world's space at every instant (no transformation, not
+    // moving) go into one index over all their triangles, as Embree builds one BVH over a
+    // scene's geometries: a ray then enters one tree instead of each overlapping mesh's tree
+    // from the top level. A mesh that a MeshInstance places keeps its own index for the
+    // instance to use. Brute force (PrimitiveList) has no levels to save, and Embree's shapes
+    // (accel/embree.hpp) keep one mesh per object.
+    static std::vector<bool> merged_meshes(const scene::Scene& scene) {
+        std::vector<bool> merged(scene.meshes.size(), false);
+        if constexpr (std::is_same_v<Index, PrimitiveList<Real>>) return merged;
+        std::vector<bool> instanced(scene.meshes.size(), false);
+        for (const auto& instance : scene.mesh_instances) instanced[instance.base_mesh] = true;
+        for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
+            const scene::Mesh& mesh = scene.meshes[m];
+            merged[m] = !instanced[m] && mesh.transform == glm::dmat4(1.0) && (!MotionBlur || mesh.motion == glm::dvec3(0.0));
+        }
+        return merged;
+    }
+
     void add_instance(Kind kind, std::uint32_t shape, std::size_t material, const glm::dmat4& transform,
                       const Aabb<Real>& object_bounds, const std::vector<std::size_t>& textures,
                       const glm::dvec3& motion) {
@@ -440,7 +515,28 @@ private:
         return spheres_[instance.shape].intersect(local, ray.t_min, t_max, t) && t < t_max;
     }
 
+    // The merged meshes of one culling class and the index over their triangles.
+    struct WorldMeshes {
+        std::optional<Mesh> index;  // over the parts' triangles, numbered part after part
+        bool smooth = false;        // its parts' culling class
+        std::vector<std::uint32_t> objects;         // per part, its object (Hit::object)
+        std::vector<std::uint32_t> first_triangle;  // per part, the number of its first triangle
+
+        // The hit on triangle `number` of the index (hit.primitive holds the index's slot)
+        // as a hit on its own mesh: its object, its triangle there (the file's order, which
+        // its ShadingOnly mesh keeps).
+        void attribute(std::uint32_t number, Hit<Real>& hit) const {
+            const std::size_t part =
+                std::size_t(std::upper_bound(first_triangle.begin(), first_triangle.end(), number) - first_triangle.begin()) - 1;
+            hit.object = objects[part];
+            hit.primitive = number - first_triangle[part];
+        }
+    };
+
     std::vector<TriangleMesh<Real, Policy>> meshes_;
+    std::vector<WorldMeshes> world_meshes_;
+    std::vector<std::uint32_t> top_objects_;  // the top level's primitives: the objects not merged
+    Aabb<Real> bounds_;
     std::vector<SphereShape<Real>> spheres_;
     std::vector<PlaneShape<Real>> planes_;
     std::vector<std::uint32_t> plane_materials_;
