@@ -1,6 +1,8 @@
 // All the geometry of a scene in the renderer's precision: meshes (each with its own index),
 // spheres and planes, placed by instances under a top-level index. This is the two-level
 // hierarchy: a MeshInstance costs one instance record, never a copy of its mesh or its BVH.
+// The meshes already in world space (no transformation, not moving, not instanced) share one
+// index over all their triangles instead, traversed beside the top level (merged_meshes).
 // It satisfies Accelerator: intersect (closest hit) and occluded (any hit).
 // With MotionBlur, an object with a MotionBlur translation m is at M p + m t at shutter instant
 // t: rays are moved back by m t before entering its object space, and its world box covers the
