@@ -174,11 +174,13 @@ public:
         // tests any box.
         bool found = false;
         for (const WorldMeshes& group : world_meshes_) {
+            const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
+            if (!enters(index, ray)) continue;
+            if (!world_triangle_ray) world_triangle_ray.emplace(ray);
             const bool cull =
                 Culling == BackfaceCulling::all || (Culling == BackfaceCulling::flat_triangles && !group.smooth);
-            const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
-            const bool group_hit = cull ? index.template intersect<true>(ray, traversal_ray, world_triangle_ray, ray.t_max, hit)
-                                        : index.template intersect<false>(ray, traversal_ray, world_triangle_ray, ray.t_max, hit);
+            const bool group_hit = cull ? index.template intersect<true>(ray, traversal_ray, *world_triangle_ray, ray.t_max, hit)
+                                        : index.template intersect<false>(ray, traversal_ray, *world_triangle_ray, ray.t_max, hit);
             if (group_hit) {
                 if (group.index) group.attribute(index.source_triangle(hit.primitive), hit);
                 else hit.object = group.objects[0];
@@ -227,7 +229,9 @@ public:
         std::optional<TriangleRay> world_triangle_ray;
         for (const WorldMeshes& group : world_meshes_) {
             const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
-            if (index.occluded(ray, traversal_ray, world_triangle_ray, ray.t_max)) return true;
+            if (!enters(index, ray)) continue;
+            if (!world_triangle_ray) world_triangle_ray.emplace(ray);
+            if (index.occluded(ray, traversal_ray, *world_triangle_ray, ray.t_max)) return true;
         }
         const auto& order = top_.primitive_indices();
         const bool blocked =
@@ -479,6 +483,15 @@ private:
             }
         }
         return instance.transformed ? instance.to_object(ray) : ray;
+    }
+
+    // Whether the ray meets the box of a world-space index within its interval, by the same
+    // conservative slab test as the BVHs (Ize's widened exit): the triangle set-up is then made
+    // before the index is entered (eagerly, outside the kernel's leaf loop) and only for rays
+    // that may reach a leaf, as the top level's box test did for a mesh in it.
+    static bool enters(const Mesh& index, const Ray<Real>& ray) {
+        return intersect_box(index.bounds(), RayBoxPrecomputed<Real>(ray), ray.t_min, ray.t_max,
+                             Real(1) + 2 * gamma<Real>(3)) != infinity<Real>;
     }
 
     // Whether the instance's object space is the world's at every instant: then its mesh

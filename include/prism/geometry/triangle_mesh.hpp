@@ -16,7 +16,6 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <optional>
 #include <span>
 #include <type_traits>
 #include <vector>
@@ -108,27 +107,13 @@ public:
     template <bool CullBackfaces>
     bool intersect(const Ray<Real>& ray, const TraversalRay& traversal_ray, const TriangleRay& triangle_ray, Real& t_max,
                    Hit<Real>& hit) const {
-        return intersect<CullBackfaces>(ray, traversal_ray, [&]() -> const TriangleRay& { return triangle_ray; }, t_max, hit);
-    }
-
-    // The same with the triangle set-up made at the first leaf the ray reaches, if any: a ray
-    // that misses the mesh's box (most of a dragon's camera rays) never pays for it.
-    template <bool CullBackfaces>
-    bool intersect(const Ray<Real>& ray, const TraversalRay& traversal_ray, std::optional<TriangleRay>& triangle_ray,
-                   Real& t_max, Hit<Real>& hit) const {
-        return intersect<CullBackfaces>(ray, traversal_ray, made_once(ray, triangle_ray), t_max, hit);
-    }
-
-    // `triangle_ray()` gives the ray's triangle set-up (TriangleRay).
-    template <bool CullBackfaces, class TriangleRayOf>
-        requires std::is_invocable_r_v<const TriangleRay&, TriangleRayOf>
-    bool intersect(const Ray<Real>& ray, const TraversalRay& traversal_ray, TriangleRayOf triangle_ray, Real& t_max,
-                   Hit<Real>& hit) const {
+        const Prepared& prepared = triangle_ray.prepared;
         if constexpr (packed) {
+            const typename Packets::PackedRay& packed_ray = triangle_ray.packed_ray;
             bool found = false;
             index_.traverse_closest(traversal_ray, ray.t_min, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
-                const bool leaf_hit = packets_.template intersect<CullBackfaces>(triangle_ray().packed_ray, ray.direction,
-                                                                                 first, count, ray.t_min, t_limit, hit);
+                const bool leaf_hit = packets_.template intersect<CullBackfaces>(packed_ray, ray.direction, first,
+                                                                                 count, ray.t_min, t_limit, hit);
                 found |= leaf_hit;
                 return leaf_hit;
             }, [&](std::uint32_t first) { packets_.prefetch(first); });
@@ -136,7 +121,6 @@ public:
         }
         bool found = false;
         index_.traverse_closest(traversal_ray, ray.t_min, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
-            const Prepared& prepared = triangle_ray().prepared;
             bool leaf_hit = false;
             for (std::uint32_t slot = first; slot < first + count; ++slot) {
                 const auto& p = triangles_[slot];
@@ -185,22 +169,14 @@ public:
 
     // The same with the ray's set-up made by the caller, as for intersect.
     bool occluded(const Ray<Real>& ray, const TraversalRay& traversal_ray, const TriangleRay& triangle_ray, Real t_max) const {
-        return occluded(ray, traversal_ray, [&]() -> const TriangleRay& { return triangle_ray; }, t_max);
-    }
-    bool occluded(const Ray<Real>& ray, const TraversalRay& traversal_ray, std::optional<TriangleRay>& triangle_ray,
-                  Real t_max) const {
-        return occluded(ray, traversal_ray, made_once(ray, triangle_ray), t_max);
-    }
-    template <class TriangleRayOf>
-        requires std::is_invocable_r_v<const TriangleRay&, TriangleRayOf>
-    bool occluded(const Ray<Real>& ray, const TraversalRay& traversal_ray, TriangleRayOf triangle_ray, Real t_max) const {
+        const Prepared& prepared = triangle_ray.prepared;
         if constexpr (packed) {
+            const typename Packets::PackedRay& packed_ray = triangle_ray.packed_ray;
             return index_.traverse_any(traversal_ray, ray.t_min, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
-                return packets_.occluded(triangle_ray().packed_ray, first, count, ray.t_min, t_limit);
+                return packets_.occluded(packed_ray, first, count, ray.t_min, t_limit);
             }, [&](std::uint32_t first) { packets_.prefetch(first); });
         }
         return index_.traverse_any(traversal_ray, ray.t_min, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
-            const Prepared& prepared = triangle_ray().prepared;
             for (std::uint32_t slot = first; slot < first + count; ++slot) {
                 const auto& p = triangles_[slot];
                 TriangleHit<Real> triangle_hit;
@@ -251,14 +227,6 @@ public:
     }
 
 private:
-    // A TriangleRay source that makes the set-up on its first call and keeps it in `kept`.
-    static auto made_once(const Ray<Real>& ray, std::optional<TriangleRay>& kept) {
-        return [&ray, &kept]() -> const TriangleRay& {
-            if (!kept) kept.emplace(ray);
-            return *kept;
-        };
-    }
-
     // The index over the parts' triangles (their boxes widened where Storage is wider than
     // Real), and the triangles copied into its slots, with their packets.
     void build_index(std::span<const scene::Mesh* const> parts) {
