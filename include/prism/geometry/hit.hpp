@@ -14,7 +14,9 @@ struct Hit {
     Real t = infinity<Real>;
     std::uint32_t object = 0;     // index of the instance (or plane) hit
     // A triangle's position in its mesh's index order (TriangleMesh reorders triangles for
-    // locality), not its position in scene::Mesh::triangles; 0 for spheres and planes.
+    // locality), not its position in scene::Mesh::triangles, except for a mesh that shares
+    // SceneGeometry's merged world-space index with others: it keeps the file's order. 0 for
+    // spheres and planes.
     std::uint32_t primitive = 0;
     Real b1 = 0, b2 = 0;          // barycentrics for triangles
 };

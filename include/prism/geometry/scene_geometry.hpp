@@ -1,6 +1,8 @@
 // All the geometry of a scene in the renderer's precision: meshes (each with its own index),
 // spheres and planes, placed by instances under a top-level index. This is the two-level
 // hierarchy: a MeshInstance costs one instance record, never a copy of its mesh or its BVH.
+// The meshes already in world space (no transformation, not moving, not instanced) share one
+// index over all their triangles instead, traversed beside the top level (merged_meshes).
 // It satisfies Accelerator: intersect (closest hit) and occluded (any hit).
 // With MotionBlur, an object with a MotionBlur translation m is at M p + m t at shutter instant
 // t: rays are moved back by m t before entering its object space, and its world box covers the
@@ -17,8 +19,11 @@
 #include <prism/geometry/triangle_mesh.hpp>
 #include <prism/scene/scene.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
+#include <span>
+#include <type_traits>
 #include <vector>
 
 namespace prism {
@@ -58,9 +63,19 @@ public:
     using Index = typename Policy::template Index<Real>;
 
     explicit SceneGeometry(const scene::Scene& scene) {
+        const std::vector<bool> merged = merged_meshes(scene);
+        // A culling class of one mesh needs no merged index: that mesh keeps its own, read
+        // without the translation a merged index's hits need (a cache miss per hit ray on the
+        // 766k-triangle dragon: 5-9% of its camera rays' time).
+        std::size_t class_size[2] = {0, 0};
+        for (std::size_t m = 0; m < scene.meshes.size(); ++m)
+            if (merged[m]) ++class_size[scene.meshes[m].shading == scene::ShadingMode::smooth];
+        auto alone = [&](std::size_t m) { return class_size[scene.meshes[m].shading == scene::ShadingMode::smooth] == 1; };
         meshes_.reserve(scene.meshes.size());
-        for (const auto& mesh : scene.meshes) {
-            meshes_.emplace_back(mesh);
+        for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
+            const scene::Mesh& mesh = scene.meshes[m];
+            if (merged[m] && !alone(m)) meshes_.emplace_back(mesh, typename Mesh::ShadingOnly{});
+            else meshes_.emplace_back(mesh);
             add_instance(Kind::mesh, std::uint32_t(meshes_.size() - 1), mesh.material, mesh.transform,
                          meshes_.back().bounds(), mesh.textures, mesh.motion);
             emitted_.emplace_back(mesh.radiance);
@@ -84,9 +99,31 @@ public:
             plane_materials_.push_back(std::uint32_t(plane.material));
             plane_textures_.push_back(add_texture_list(plane.textures));
         }
+        // One index per culling class over the merged meshes (flat ones are culled under
+        // flat_triangles, smooth ones never), the instance of mesh m being object m.
+        for (const bool smooth : {false, true}) {
+            WorldMeshes group;
+            group.smooth = smooth;
+            std::vector<const scene::Mesh*> parts;
+            std::uint32_t triangles = 0;
+            for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
+                if (!merged[m] || meshes_[m].smooth() != smooth) continue;
+                parts.push_back(&scene.meshes[m]);
+                group.objects.push_back(std::uint32_t(m));
+                group.first_triangle.push_back(triangles);
+                triangles += std::uint32_t(scene.meshes[m].triangles.size());
+            }
+            if (parts.empty()) continue;
+            if (parts.size() > 1) group.index.emplace(std::span<const scene::Mesh* const>(parts));
+            world_meshes_.push_back(std::move(group));
+        }
         std::vector<Aabb<Real>> boxes;
-        boxes.reserve(instances_.size());
-        for (const auto& instance : instances_) boxes.push_back(instance.world_bounds);
+        for (std::uint32_t object = 0; object < instances_.size(); ++object) {
+            bounds_.extend(instances_[object].world_bounds);
+            if (object < merged.size() && merged[object]) continue;
+            top_objects_.push_back(object);
+            boxes.push_back(instances_[object].world_bounds);
+        }
         // One instance per leaf where the index takes the option: testing an instance (a
         // transform, then its mesh's own BVH or its sphere) costs far more than the box test
         // that could skip it. With the wide BVH's leaves of up to 8, a scene of a few instances
@@ -105,12 +142,21 @@ public:
             if (instance.kind == Kind::mesh) total += meshes_[instance.shape].triangle_count();
         return total;
     }
-    Aabb<Real> bounds() const { return top_.bounds(); }
-    // The indices of both levels and the triangles their leaves test (bench/scaling_bench.cpp).
+    Aabb<Real> bounds() const { return bounds_; }
+    // The indices of both levels, the merged world-space index, and the triangles their leaves
+    // test or shading reads (bench/scaling_bench.cpp).
     std::size_t accelerator_bytes() const {
         std::size_t total = top_.memory_bytes();
         for (const auto& mesh : meshes_) total += mesh.accelerator_bytes();
+        for (const auto& group : world_meshes_)
+            if (group.index) total += group.index->accelerator_bytes();
         return total;
+    }
+    // How many meshes share one world-space index instead of a top-level entry each.
+    std::size_t merged_mesh_count() const {
+        std::size_t count = 0;
+        for (const auto& group : world_meshes_) count += group.objects.size();
+        return count;
     }
 
     // The radiance object `object` (Hit::object) emits from its surface: a LightMesh's or
@@ -122,14 +168,31 @@ public:
     // (geometry/backface_culling.hpp).
     template <BackfaceCulling Culling = BackfaceCulling::none>
     bool intersect(Ray<Real>& ray, Hit<Real>& hit) const {
-        bool found = false;
-        const auto& order = top_.primitive_indices();
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;  // made when the ray first enters a mesh
+        // The merged world-space meshes first: their hit lowers t_max before the top level
+        // tests any box.
+        bool found = false;
+        for (const WorldMeshes& group : world_meshes_) {
+            const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
+            if (!enters(index, ray)) continue;
+            if (!world_triangle_ray) world_triangle_ray.emplace(ray);
+            const bool cull =
+                Culling == BackfaceCulling::all || (Culling == BackfaceCulling::flat_triangles && !group.smooth);
+            const bool group_hit = cull ? index.template intersect<true>(ray, traversal_ray, *world_triangle_ray, ray.t_max, hit)
+                                        : index.template intersect<false>(ray, traversal_ray, *world_triangle_ray, ray.t_max, hit);
+            if (group_hit) {
+                if (group.index) group.attribute(index.source_triangle(hit.primitive), hit);
+                else hit.object = group.objects[0];
+                found = true;
+            }
+        }
+        if (top_objects_.empty()) return intersect_planes<Culling>(ray, hit) || found;
+        const auto& order = top_.primitive_indices();
         top_.traverse_closest(traversal_ray, ray.t_min, ray.t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_max) {
             bool leaf_hit = false;
             for (std::uint32_t i = first; i < first + count; ++i) {
-                const std::uint32_t object = order[i];
+                const std::uint32_t object = top_objects_[order[i]];
                 if (intersect_instance<Culling>(instances_[object], ray, traversal_ray, world_triangle_ray, t_max, hit)) {
                     hit.object = object;
                     leaf_hit = true;
@@ -162,13 +225,21 @@ public:
 
     // Whether anything lies in (ray.t_min, ray.t_max).
     bool occluded(const Ray<Real>& ray) const {
-        const auto& order = top_.primitive_indices();
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;
+        for (const WorldMeshes& group : world_meshes_) {
+            const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
+            if (!enters(index, ray)) continue;
+            if (!world_triangle_ray) world_triangle_ray.emplace(ray);
+            if (index.occluded(ray, traversal_ray, *world_triangle_ray, ray.t_max)) return true;
+        }
+        const auto& order = top_.primitive_indices();
         const bool blocked =
+            !top_objects_.empty() &&
             top_.traverse_any(traversal_ray, ray.t_min, ray.t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_max) {
                 for (std::uint32_t i = first; i < first + count; ++i)
-                    if (occludes(instances_[order[i]], ray, traversal_ray, world_triangle_ray, t_max)) return true;
+                    if (occludes(instances_[top_objects_[order[i]]], ray, traversal_ray, world_triangle_ray, t_max))
+                        return true;
                 return false;
             });
         return blocked || occluded_by_planes(ray);
@@ -331,6 +402,24 @@ private:
         }
     };
 
+    // The meshes that share the world's space at every instant (no transformation, not
+    // moving) go into one index over all their triangles, as Embree builds one BVH over a
+    // scene's geometries: a ray then enters one tree instead of each overlapping mesh's tree
+    // from the top level. A mesh that a MeshInstance places keeps its own index for the
+    // instance to use. Brute force (PrimitiveList) has no levels to save, and Embree's shapes
+    // (accel/embree.hpp) keep one mesh per object.
+    static std::vector<bool> merged_meshes(const scene::Scene& scene) {
+        std::vector<bool> merged(scene.meshes.size(), false);
+        if constexpr (std::is_same_v<Index, PrimitiveList<Real>>) return merged;
+        std::vector<bool> instanced(scene.meshes.size(), false);
+        for (const auto& instance : scene.mesh_instances) instanced[instance.base_mesh] = true;
+        for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
+            const scene::Mesh& mesh = scene.meshes[m];
+            merged[m] = !instanced[m] && mesh.transform == glm::dmat4(1.0) && (!MotionBlur || mesh.motion == glm::dvec3(0.0));
+        }
+        return merged;
+    }
+
     void add_instance(Kind kind, std::uint32_t shape, std::size_t material, const glm::dmat4& transform,
                       const Aabb<Real>& object_bounds, const std::vector<std::size_t>& textures,
                       const glm::dvec3& motion) {
@@ -396,6 +485,15 @@ private:
         return instance.transformed ? instance.to_object(ray) : ray;
     }
 
+    // Whether the ray meets the box of a world-space index within its interval, by the same
+    // conservative slab test as the BVHs (Ize's widened exit): the triangle set-up is then made
+    // before the index is entered (eagerly, outside the kernel's leaf loop) and only for rays
+    // that may reach a leaf, as the top level's box test did for a mesh in it.
+    static bool enters(const Mesh& index, const Ray<Real>& ray) {
+        return intersect_box(index.bounds(), RayBoxPrecomputed<Real>(ray), ray.t_min, ray.t_max,
+                             Real(1) + 2 * gamma<Real>(3)) != infinity<Real>;
+    }
+
     // Whether the instance's object space is the world's at every instant: then its mesh
     // reuses the world ray's set-up (the same ray, bit for bit) instead of preparing its own.
     static bool in_world_space(const Instance& instance) {
@@ -440,7 +538,30 @@ private:
         return spheres_[instance.shape].intersect(local, ray.t_min, t_max, t) && t < t_max;
     }
 
+    // The merged meshes of one culling class and the index over their triangles.
+    struct WorldMeshes {
+        // Over the parts' triangles, numbered part after part; none for a single part, which
+        // is traversed through its own mesh's index (and keeps its index order).
+        std::optional<Mesh> index;
+        bool smooth = false;        // its parts' culling class
+        std::vector<std::uint32_t> objects;         // per part, its object (Hit::object)
+        std::vector<std::uint32_t> first_triangle;  // per part, the number of its first triangle
+
+        // The hit on triangle `number` of the index (hit.primitive holds the index's slot)
+        // as a hit on its own mesh: its object, its triangle there (the file's order, which
+        // its ShadingOnly mesh keeps).
+        void attribute(std::uint32_t number, Hit<Real>& hit) const {
+            const std::size_t part =
+                std::size_t(std::upper_bound(first_triangle.begin(), first_triangle.end(), number) - first_triangle.begin()) - 1;
+            hit.object = objects[part];
+            hit.primitive = number - first_triangle[part];
+        }
+    };
+
     std::vector<TriangleMesh<Real, Policy>> meshes_;
+    std::vector<WorldMeshes> world_meshes_;
+    std::vector<std::uint32_t> top_objects_;  // the top level's primitives: the objects not merged
+    Aabb<Real> bounds_;
     std::vector<SphereShape<Real>> spheres_;
     std::vector<PlaneShape<Real>> planes_;
     std::vector<std::uint32_t> plane_materials_;

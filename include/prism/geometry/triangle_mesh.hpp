@@ -1,6 +1,8 @@
 // A triangle mesh in its object space with its own spatial index: the bottom level of the
 // two-level hierarchy, shared by every instance of the mesh. Triangles are stored as a vertex
 // soup in index order, so a leaf reads contiguous memory; shading data stays indexed.
+// SceneGeometry also builds one over several meshes in world space (one index for all their
+// triangles), whose parts then keep only their shading data (ShadingOnly).
 #pragma once
 
 #include <prism/accel/accelerator.hpp>
@@ -14,6 +16,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <type_traits>
 #include <vector>
 
@@ -32,36 +35,46 @@ public:
 
     explicit TriangleMesh(const scene::Mesh& mesh)
         : smooth_(mesh.shading == scene::ShadingMode::smooth), triangle_count_(mesh.triangles.size()) {
-        const std::size_t count = mesh.triangles.size();
-        std::vector<Aabb<Real>> boxes(count);
-        for (std::size_t i = 0; i < count; ++i) {
-            for (std::uint32_t v : mesh.triangles[i]) boxes[i].extend(Vec3<Real>(mesh.positions[v]));
-            // Vertices kept wider than Real are rounded for the box: widen it by one ulp on
-            // each side so the box still contains the triangle the intersector tests.
-            if constexpr (!std::is_same_v<Storage, Real>) {
-                for (int axis = 0; axis < 3; ++axis) {
-                    boxes[i].min[axis] = next_down(boxes[i].min[axis]);
-                    boxes[i].max[axis] = next_up(boxes[i].max[axis]);
-                }
-            }
-            bounds_.extend(boxes[i]);
-        }
-        index_ = Index::build(boxes);
-        // An index may repeat primitives to pad its leaves (the wide BVH): slots then outnumber
-        // triangles, and the repeats are copies that no leaf callback reports.
+        const scene::Mesh* const parts[] = {&mesh};
+        build_index(parts);
         const auto& order = index_.primitive_indices();
-        triangles_.resize(order.size());
         faces_.resize(order.size());
-        for (std::size_t slot = 0; slot < order.size(); ++slot) {
-            const auto& face = mesh.triangles[order[slot]];
-            faces_[slot] = face;
-            for (int k = 0; k < 3; ++k) triangles_[slot][k] = Vec3<Storage>(mesh.positions[face[k]]);
-        }
-        if constexpr (packed) packets_ = Packets(triangles_);
-        if (smooth_) vertex_normals_ = smooth_normals(mesh);
-        if (!mesh.uvs.empty())
-            for (const auto& uv : mesh.uvs) uvs_.emplace_back(uv);
+        for (std::size_t slot = 0; slot < order.size(); ++slot) faces_[slot] = mesh.triangles[order[slot]];
+        keep_shading_data(mesh);
     }
+
+    // A mesh whose triangles another index tests (SceneGeometry's world-space meshes, merged
+    // into one index): it keeps only what surface() and spawn_point() read, its triangles in
+    // the file's order, so a slot here is the triangle's index in scene::Mesh::triangles.
+    struct ShadingOnly {};
+    TriangleMesh(const scene::Mesh& mesh, ShadingOnly)
+        : smooth_(mesh.shading == scene::ShadingMode::smooth), triangle_count_(mesh.triangles.size()) {
+        triangles_.resize(mesh.triangles.size());
+        faces_ = mesh.triangles;
+        for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+            for (int k = 0; k < 3; ++k) triangles_[i][k] = Vec3<Storage>(mesh.positions[mesh.triangles[i][k]]);
+            bounds_.extend(triangle_box(mesh, mesh.triangles[i]));
+        }
+        keep_shading_data(mesh);
+    }
+
+    // One index over the triangles of several meshes that share a space, numbered part after
+    // part (part 0's triangles first): for traversal only. A hit's slot names its triangle
+    // through source_triangle; shading stays with each part's own (ShadingOnly) mesh, so
+    // surface(), spawn_point() and the single-triangle tests are not for this mesh.
+    explicit TriangleMesh(std::span<const scene::Mesh* const> parts) {
+        for (const scene::Mesh* part : parts) triangle_count_ += part->triangles.size();
+        build_index(parts);
+        // The packets hold the leaves' triangles: the plain copy would be read by nothing.
+        if constexpr (packed) {
+            triangles_.clear();
+            triangles_.shrink_to_fit();
+        }
+    }
+
+    // The triangle in `slot`, numbered as the meshes it was built from list them (part after
+    // part for several meshes).
+    std::uint32_t source_triangle(std::uint32_t slot) const { return index_.primitive_indices()[slot]; }
 
     Aabb<Real> bounds() const { return bounds_; }
     std::size_t triangle_count() const { return triangle_count_; }
@@ -214,6 +227,57 @@ public:
     }
 
 private:
+    // The index over the parts' triangles (their boxes widened where Storage is wider than
+    // Real), and the triangles copied into its slots, with their packets.
+    void build_index(std::span<const scene::Mesh* const> parts) {
+        std::vector<Aabb<Real>> boxes;
+        boxes.reserve(triangle_count_);
+        std::vector<const std::array<std::uint32_t, 3>*> faces;
+        std::vector<const scene::Mesh*> owners;
+        faces.reserve(triangle_count_);
+        owners.reserve(triangle_count_);
+        for (const scene::Mesh* part : parts) {
+            for (const auto& face : part->triangles) {
+                const Aabb<Real> box = triangle_box(*part, face);
+                bounds_.extend(box);
+                boxes.push_back(box);
+                faces.push_back(&face);
+                owners.push_back(part);
+            }
+        }
+        index_ = Index::build(boxes);
+        // An index may repeat primitives to pad its leaves (the wide BVH): slots then outnumber
+        // triangles, and the repeats are copies that no leaf callback reports.
+        const auto& order = index_.primitive_indices();
+        triangles_.resize(order.size());
+        for (std::size_t slot = 0; slot < order.size(); ++slot) {
+            const auto& face = *faces[order[slot]];
+            const scene::Mesh& owner = *owners[order[slot]];
+            for (int k = 0; k < 3; ++k) triangles_[slot][k] = Vec3<Storage>(owner.positions[face[k]]);
+        }
+        if constexpr (packed) packets_ = Packets(triangles_);
+    }
+
+    static Aabb<Real> triangle_box(const scene::Mesh& mesh, const std::array<std::uint32_t, 3>& face) {
+        Aabb<Real> box;
+        for (std::uint32_t v : face) box.extend(Vec3<Real>(mesh.positions[v]));
+        // Vertices kept wider than Real are rounded for the box: widen it by one ulp on each
+        // side so the box still contains the triangle the intersector tests.
+        if constexpr (!std::is_same_v<Storage, Real>) {
+            for (int axis = 0; axis < 3; ++axis) {
+                box.min[axis] = next_down(box.min[axis]);
+                box.max[axis] = next_up(box.max[axis]);
+            }
+        }
+        return box;
+    }
+
+    void keep_shading_data(const scene::Mesh& mesh) {
+        if (smooth_) vertex_normals_ = smooth_normals(mesh);
+        if (!mesh.uvs.empty())
+            for (const auto& uv : mesh.uvs) uvs_.emplace_back(uv);
+    }
+
     // Vertex normals as the course's renderer computes them: the normalised sum of the faces'
     // unnormalised normals, i.e. weighted by face area (with unit face normals instead,
     // low_poly_smooth drops from 58 to 30 dB against the course's image). A PLY file's own
@@ -242,8 +306,10 @@ private:
     Aabb<Real> bounds_;
     Index index_;
     [[no_unique_address]] Packets packets_;
-    std::vector<std::array<Vec3<Storage>, 3>> triangles_;  // in index order
-    std::vector<std::array<std::uint32_t, 3>> faces_;      // vertex indices, in index order
+    // In slot order: the index's order, or the file's for a ShadingOnly mesh. A mesh over
+    // several parts keeps no faces, and no triangles where its packets hold them.
+    std::vector<std::array<Vec3<Storage>, 3>> triangles_;
+    std::vector<std::array<std::uint32_t, 3>> faces_;  // vertex indices
     std::vector<Vec3<Real>> vertex_normals_;
     std::vector<Vec2<Real>> uvs_;
 };
