@@ -111,9 +111,7 @@ public:
     }
 
 private:
-    // Ize, "Robust BVH Ray Traversal" (JCGT 2013): widening every far slab distance by 1 + 2
-    // gamma(3) makes the box test conservative, so rounding never culls a box the ray enters.
-    static constexpr Real far_scale = Real(1) + 2 * gamma<Real>(3);
+    static constexpr Real far_scale = robust_far_scale<Real>;  // geometry/aabb.hpp
 
     static Real enter(const BvhNode<Real>& node, const RayBoxPrecomputed<Real>& ray, Real t_min, Real t_max) {
         return intersect_box(node.bounds, ray, t_min, t_max * far_scale, far_scale);

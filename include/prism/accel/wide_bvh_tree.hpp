@@ -97,7 +97,7 @@ public:
 private:
     using Pack = simd::Pack<Real, N>;
     // Ize's conservative far distance, as in BvhTree: every exit distance times 1 + 2 gamma(3).
-    static constexpr Real far_scale = Real(1) + 2 * gamma<Real>(3);
+    static constexpr Real far_scale = robust_far_scale<Real>;
 
 public:
     // What the slab test needs of a ray, broadcast once. A two-level scene whose mesh shares

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <prism/geometry/ray.hpp>
+#include <prism/math/floating_point.hpp>
 
 #include <algorithm>
 
@@ -46,6 +47,12 @@ struct RayBoxPrecomputed {
         inverse_direction = Vec3<Real>(Real(1)) / ray.direction;
     }
 };
+
+// Ize, "Robust BVH Ray Traversal" (JCGT 2013): widening every far slab distance by 1 + 2
+// gamma(3) makes the box test conservative, so rounding never culls a box the ray enters. One
+// constant for every index that tests boxes (BvhTree, WideBvhTree, SceneGeometry's world meshes).
+template <Scalar Real>
+inline constexpr Real robust_far_scale = Real(1) + 2 * gamma<Real>(3);
 
 // Returns the entry distance, or infinity when the box is missed within [t_min, t_max].
 // The min/max ordering makes NaNs (0 * inf on a slab plane) drop out instead of accepting.
