@@ -203,6 +203,64 @@ TEST_CASE_TEMPLATE("sphere: a far origin keeps the discriminant of a near-grazin
     CHECK(sphere.bounds().max == V(1));
 }
 
+namespace {
+
+// The sphere test without its early exit for rays leaving from outside, written out here as the
+// header had it: the exit must change no answer and no bit of t.
+template <class Real>
+bool sphere_reference(const prism::SphereShape<Real>& sphere, const prism::Ray<Real>& ray, Real t_min, Real t_max,
+                      Real& t_hit) {
+    const prism::Vec3<Real> oc = ray.origin - sphere.center;
+    const Real a = glm::dot(ray.direction, ray.direction);
+    const Real half_b = glm::dot(oc, ray.direction);
+    const prism::Vec3<Real> perpendicular = oc - (half_b / a) * ray.direction;
+    const Real discriminant_over_a = sphere.radius * sphere.radius - glm::dot(perpendicular, perpendicular);
+    if (discriminant_over_a < 0) return false;
+    const Real c = glm::dot(oc, oc) - sphere.radius * sphere.radius;
+    const Real root = std::sqrt(a * discriminant_over_a);
+    const Real q = half_b >= 0 ? -(half_b + root) : -(half_b - root);
+    Real t0 = c / q, t1 = q / a;
+    if (q == 0) t0 = t1 = 0;
+    if (t0 > t1) std::swap(t0, t1);
+    for (const Real t : {t0, t1})
+        if (t > t_min && t <= t_max) {
+            t_hit = t;
+            return true;
+        }
+    return false;
+}
+
+}  // namespace
+
+TEST_CASE_TEMPLATE("sphere: the exit for rays leaving from outside gives the full test's answers, bit for bit", Real,
+                   float, double) {
+    using V = prism::Vec3<Real>;
+    std::mt19937 random(795);
+    std::uniform_real_distribution<double> coordinate(-3, 3), unit(0, 1);
+    int hits = 0, leaving = 0;
+    for (int i = 0; i < 200000; ++i) {
+        const prism::SphereShape<Real> sphere{V(Real(coordinate(random)), Real(coordinate(random)), Real(coordinate(random))),
+                                              Real(0.1 + unit(random))};
+        // Origins on, near and far from the surface; directions of any length, some toward the
+        // sphere, some away; t_min of 0, a little above and below 0.
+        V origin(Real(coordinate(random)), Real(coordinate(random)), Real(coordinate(random)));
+        if (i % 4 == 0) origin = sphere.center + sphere.radius * prism::unit_vector(origin - sphere.center);
+        const V direction = V(Real(coordinate(random)), Real(coordinate(random)), Real(coordinate(random))) *
+                            Real(i % 3 == 0 ? 1e-3 : 1.0);
+        const Real t_min = i % 5 == 0 ? Real(-0.5) : i % 5 == 1 ? Real(1e-4) : Real(0);
+        const prism::Ray<Real> ray{origin, direction};
+        Real t = -7, t_reference = -7;
+        const bool found = sphere.intersect(ray, t_min, prism::infinity<Real>, t);
+        REQUIRE(found == sphere_reference(sphere, ray, t_min, prism::infinity<Real>, t_reference));
+        REQUIRE(std::memcmp(&t, &t_reference, sizeof(Real)) == 0);
+        hits += found;
+        leaving += glm::dot(origin - sphere.center, direction) >= 0;
+    }
+    // Both kinds of ray were drawn often.
+    CHECK(hits > 20000);
+    CHECK(leaving > 50000);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Triangles, both intersectors
 

@@ -266,3 +266,77 @@ TEST_CASE("render_scene: a fitted renderer refuses what it was compiled without"
     CHECK(images.size() == 1);
     CHECK(log.str().find("motion blur") != std::string::npos);
 }
+
+TEST_CASE_TEMPLATE("Random::skip: the stream after skipping n draws is the stream after making them", Real, float,
+                   double) {
+    for (int n : {0, 1, 2, 5}) {
+        CAPTURE(n);
+        prism::Random drawn = prism::Random::for_pixel(11, 2, 7), skipped = drawn;
+        for (int i = 0; i < n; ++i) (void)drawn.uniform<Real>();
+        skipped.skip<Real>(n);
+        for (int i = 0; i < 8; ++i) REQUIRE(skipped.uniform<Real>() == drawn.uniform<Real>());
+    }
+    // Skipping is not a no-op: the next draw after a skip differs from the unskipped one.
+    prism::Random a = prism::Random::for_pixel(1, 1, 0), b = a;
+    b.skip<Real>(1);
+    CHECK(a.uniform<Real>() != b.uniform<Real>());
+}
+
+TEST_CASE_TEMPLATE("SceneGeometry::surface: without (u, v) and tangents, without the spawn point, the rest the same",
+                   Real, float, double) {
+    scene::Scene world;
+    world.materials.push_back(matte(0.5));
+    world.spheres.push_back({"plain", 0, {0, 0, 0}, 1, glm::dmat4(1.0)});
+    // Placed by a transformation: scaled and moved, so the object-space fields differ from world's.
+    world.spheres.push_back({"placed", 0, {0, 0, 0}, 1,
+                             glm::scale(glm::translate(glm::dmat4(1.0), glm::dvec3(5, 0, 0)), glm::dvec3(1, 2, 1))});
+    scene::Mesh mesh;
+    mesh.positions = {{9, -1, 0}, {11, -1, 0}, {10, 1, 0}};
+    mesh.uvs = {{0, 0}, {1, 0}, {0, 1}};
+    mesh.triangles = {{0, 1, 2}};
+    world.meshes.push_back(mesh);
+    world.planes.push_back({"floor", 0, {0, -5, 0}, {0, 1, 0}});
+    const prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight>> geometry(world);
+    const std::vector<prism::Ray<Real>> rays{
+        {prism::Vec3<Real>(Real(0.3), Real(0.4), 9), prism::Vec3<Real>(0, 0, -1)},
+        {prism::Vec3<Real>(Real(5.2), Real(0.4), 9), prism::Vec3<Real>(0, 0, -1)},
+        {prism::Vec3<Real>(Real(10.1), Real(0.2), 9), prism::Vec3<Real>(0, 0, -1)},
+        {prism::Vec3<Real>(Real(20), 0, 0), prism::Vec3<Real>(0, -1, 0)}};
+    for (std::size_t r = 0; r < rays.size(); ++r) {
+        CAPTURE(r);
+        prism::Ray<Real> ray = rays[r];
+        prism::Hit<Real> hit;
+        REQUIRE(geometry.intersect(ray, hit));
+        const prism::SurfacePoint<Real> full = geometry.surface(ray, hit);
+        const prism::SurfacePoint<Real> bare = geometry.template surface<false>(ray, hit);
+        const prism::SurfacePoint<Real> unspawned = geometry.surface(ray, hit, false);
+        CHECK(full.object_error != prism::Vec3<Real>(0));
+        CHECK(unspawned.object_point == prism::Vec3<Real>(0));
+        CHECK(unspawned.object_error == prism::Vec3<Real>(0));
+        CHECK(unspawned.uv == full.uv);
+        CHECK(unspawned.dpdu == full.dpdu);
+        CHECK(unspawned.dpdv == full.dpdv);
+        if (r < 2) {  // the spheres: (u, v) and tangents only when parametrised
+            CHECK(full.uv != prism::Vec2<Real>(0));
+            CHECK(full.dpdu != prism::Vec3<Real>(0));
+            CHECK(bare.uv == prism::Vec2<Real>(0));
+            CHECK(bare.dpdu == prism::Vec3<Real>(0));
+            CHECK(bare.dpdv == prism::Vec3<Real>(0));
+        } else {  // a mesh fills its own, planes have none
+            CHECK(bare.uv == full.uv);
+            CHECK(bare.dpdu == full.dpdu);
+        }
+        CHECK(bare.object_point == full.object_point);
+        CHECK(bare.object_error == full.object_error);
+        for (const prism::SurfacePoint<Real>* point : {&bare, &unspawned}) {
+            CHECK(point->position == full.position);
+            CHECK(point->geometric_normal == full.geometric_normal);
+            CHECK(point->shading_normal == full.shading_normal);
+            CHECK(point->local_position == full.local_position);
+            CHECK(point->object_normal == full.object_normal);
+            CHECK(point->texture_position == full.texture_position);
+            CHECK(point->material == full.material);
+            CHECK(point->object == full.object);
+        }
+    }
+}

@@ -18,6 +18,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <random>
 #include <type_traits>
 
@@ -527,4 +528,53 @@ TEST_CASE_TEMPLATE("instanced triangles: rays spawned with the InstanceTransform
     CHECK(counts.incoming_hits > 200000);
     CHECK(counts.instance_rehits == 0);
     CHECK(counts.origins_behind == 0);
+}
+
+TEST_CASE_TEMPLATE("spawn_side: rays leaving one point by the same side get the same origin, bit for bit", Real, float,
+                   double) {
+    // Instances with and without transformations (spheres and a triangle), and a plane; every
+    // direction whose spawn_side matches a first one's must give that first one's origin, as the
+    // integrator's shared shadow-ray origins assume.
+    prism::scene::Scene world;
+    world.materials.push_back({});
+    world.spheres.push_back({"plain", 0, {0.5, 0.25, -3}, 1.5, glm::dmat4(1.0)});
+    world.spheres.push_back({"placed", 0, {0, 0, 0}, 1,
+                             prism::translation({6, 1, -2}) * prism::rotation(40, {1, 2, 3}) *
+                                 prism::scaling({3, 0.5, 1})});
+    prism::scene::Mesh mesh;
+    mesh.positions = {{-7, -1, 0}, {-5, -1.5, 0.25}, {-6, 1, -0.5}};
+    mesh.triangles = {{0, 1, 2}};
+    mesh.transform = prism::scaling({1, 100, 0.01});
+    world.meshes.push_back(mesh);
+    world.planes.push_back({"floor", 0, {0, -20, 0}, glm::normalize(glm::dvec3(0.1, 1, 0.2))});
+    const prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight>> geometry(world);
+    std::mt19937_64 rng(11);
+    std::array<int, 2> sides{0, 0};
+    int points = 0;
+    for (int i = 0; i < 4000; ++i) {
+        const glm::dvec3 target = i % 4 == 0   ? glm::dvec3(0.5, 0.25, -3)
+                                  : i % 4 == 1 ? glm::dvec3(6, 1, -2)
+                                  : i % 4 == 2 ? glm::dvec3(-6, -50, 0)
+                                               : glm::dvec3(3, -20, 4);
+        const glm::dvec3 from = target + 40.0 * random_unit_vector(rng);
+        prism::Ray<Real> ray{prism::Vec3<Real>(from), prism::Vec3<Real>(glm::normalize(target - from))};
+        prism::Hit<Real> hit;
+        if (!geometry.intersect(ray, hit)) continue;
+        ++points;
+        const prism::SurfacePoint<Real> point = geometry.surface(ray, hit);
+        std::array<std::optional<prism::Vec3<Real>>, 4> first;
+        for (int d = 0; d < 16; ++d) {
+            const prism::Vec3<Real> direction(random_unit_vector(rng));
+            const int side = geometry.spawn_side(point, direction);
+            REQUIRE(side >= 0);
+            REQUIRE(side < 2);  // nothing moves here
+            ++sides[std::size_t(side)];
+            const prism::Vec3<Real> origin = geometry.spawn_origin(point, direction);
+            if (!first[std::size_t(side)]) first[std::size_t(side)] = origin;
+            else REQUIRE(*first[std::size_t(side)] == origin);
+        }
+    }
+    CHECK(points > 2000);
+    CHECK(sides[0] > 5000);
+    CHECK(sides[1] > 5000);
 }

@@ -271,6 +271,20 @@ TEST_CASE_TEMPLATE("Renderer: Blinn-Phong under one point light equals the hand 
                    world.background_color, 1e-6);
 }
 
+TEST_CASE_TEMPLATE("Renderer: without a specular colour, ambient and diffuse only, at every exponent", Real, float,
+                   double) {
+    // The integrator skips the power for such a material; a negative exponent still takes it.
+    for (double exponent : {10.0, 0.0, 1e9, -2.0}) {
+        CAPTURE(exponent);
+        scene::Scene world = lit_scene();
+        world.materials[0].specular = {0, 0, 0};
+        world.materials[0].phong_exponent = exponent;
+        const glm::dvec3 expected = world.materials[0].ambient * world.ambient_light +
+                                    world.materials[0].diffuse * (2.0 / 3) * 100.0;
+        check_relative(centre_pixel<Real>(world), expected, 1e-4);
+    }
+}
+
 TEST_CASE_TEMPLATE("Renderer: a sphere between the light and the point leaves ambient only", Real, float, double) {
     scene::Scene world = lit_scene();
     // Centred on the segment from (0, 0, -2) to the light, clear of the camera's centre ray.

@@ -296,7 +296,15 @@ public:
     }
     Aabb<Real> world_bounds(std::uint32_t object) const { return instances_[object].world_bounds; }
 
-    SurfacePoint<Real> surface(const Ray<Real>& ray, const Hit<Real>& hit) const {
+    // Two parts are left out for callers that never read them. `Parametrised` false leaves a
+    // sphere's (u, v) and tangents zero: renderers compiled without textures never read them,
+    // and the sphere's acos, atan2 and sincos were 6-8% of a mirror sphere scene's time (hw1
+    // mirror_spheres); meshes fill theirs as before. `spawn_point` false leaves object_point and
+    // object_error zero, which only spawn_origin reads: rays that leave by the scene's epsilon
+    // (45 of the 57 hw1-hw2 course scenes) never call it, and a triangle's spawn point (its
+    // error bound, in double) was 5% of a small scene's time.
+    template <bool Parametrised = true>
+    SurfacePoint<Real> surface(const Ray<Real>& ray, const Hit<Real>& hit, bool spawn_point = true) const {
         SurfacePoint<Real> point;
         point.position = ray.at(hit.t);
         point.object = hit.object;
@@ -305,9 +313,11 @@ public:
             const std::size_t p = hit.object - instances_.size();
             point.geometric_normal = point.shading_normal = point.object_normal = planes_[p].normal;
             point.texture_position = point.position;
-            const PointWithError<Real> exact = planes_[p].hit_point(point.position);
-            point.object_point = exact.point;
-            point.object_error = exact.error;
+            if (spawn_point) {
+                const PointWithError<Real> exact = planes_[p].hit_point(point.position);
+                point.object_point = exact.point;
+                point.object_error = exact.error;
+            }
             point.local_position = point.position;
             point.material = plane_materials_[p];
             point.textures = texture_lists_[plane_textures_[p]];
@@ -323,12 +333,12 @@ public:
         if (instance.kind == Kind::mesh) {
             const auto& mesh = meshes_[instance.shape];
             mesh.surface(hit, geometric_normal, shading_normal, point.uv, point.dpdu, point.dpdv);
-            exact = mesh.spawn_point(hit);
+            if (spawn_point) exact = mesh.spawn_point(hit);
         } else {
             const SphereShape<Real>& sphere = spheres_[instance.shape];
             geometric_normal = shading_normal = glm::normalize(point.local_position - sphere.center);
-            sphere.parametrise(point.local_position, point.uv, point.dpdu, point.dpdv);
-            exact = sphere_hit_point(sphere.center, sphere.radius, point.local_position);
+            if constexpr (Parametrised) sphere.parametrise(point.local_position, point.uv, point.dpdu, point.dpdv);
+            if (spawn_point) exact = sphere_hit_point(sphere.center, sphere.radius, point.local_position);
         }
         point.object_point = exact.point;
         point.object_error = exact.error;
@@ -373,6 +383,25 @@ public:
             }
         }
         return origin;
+    }
+
+    // spawn_origin's answer depends on the direction only through the side of the surface the
+    // ray leaves by, as each offset_ray_origin it calls decides it (in object space for an
+    // instance with a transformation; the world normal's side too for a moving one): 0 to 3.
+    // Rays that leave one point by the same side start from the same origin, so the shadow rays
+    // to every light can share one (the error-bounded origin of an instance was a third of
+    // hw2 metal_glass_plates' time, computed again for each of its lights).
+    int spawn_side(const SurfacePoint<Real>& point, const Vec3<Real>& direction) const {
+        if (point.object >= instances_.size()) return glm::dot(direction, point.object_normal) < 0;
+        const Instance& instance = instances_[point.object];
+        int side = instance.transformed
+                       ? glm::dot(Mat3<Real>(transforms_[instance.transform].world_to_object) * direction,
+                                  point.object_normal) < 0
+                       : glm::dot(direction, point.object_normal) < 0;
+        if constexpr (MotionBlur) {
+            if (instance.moving) side += 2 * (glm::dot(direction, point.geometric_normal) < 0);
+        }
+        return side;
     }
 
 private:

@@ -22,13 +22,19 @@ struct SphereShape {
         const Vec3<Real> oc = ray.origin - center;
         const Real a = glm::dot(ray.direction, ray.direction);
         const Real half_b = glm::dot(oc, ray.direction);
+        const Real c = glm::dot(oc, oc) - radius * radius;
+        // An origin outside the sphere (c > 0) on a ray leaving it (half_b >= 0) gives q <= 0
+        // below, so both roots c/q and q/a are at most 0 in floating point too: no root past a
+        // t_min of 0 or more. Half the rays that miss a sphere (shadow rays, reflections) end
+        // here, before the division and the square root; the answer is the one the full
+        // computation gives.
+        if (half_b >= 0 && c > 0 && t_min >= 0) return false;
         // c computed as |oc|^2 - r^2 would cancel catastrophically for far-away origins; the
         // difference of squares on the perpendicular distance keeps the discriminant accurate
         // (Haines et al., Ray Tracing Gems ch. 7).
         const Vec3<Real> perpendicular = oc - (half_b / a) * ray.direction;
         const Real discriminant_over_a = radius * radius - glm::dot(perpendicular, perpendicular);
         if (discriminant_over_a < 0) return false;
-        const Real c = glm::dot(oc, oc) - radius * radius;
         const Real root = std::sqrt(a * discriminant_over_a);
         const Real q = half_b >= 0 ? -(half_b + root) : -(half_b - root);
         Real t0 = c / q, t1 = q / a;

@@ -9,12 +9,14 @@
 
 #include <prism/geometry/backface_culling.hpp>
 #include <prism/geometry/hit.hpp>
+#include <prism/light/light_sample.hpp>
 #include <prism/material/fresnel.hpp>
 #include <prism/material/material.hpp>
 #include <prism/render/integrator.hpp>
 #include <prism/sampling/random.hpp>
 #include <prism/texture/mipmap.hpp>
 
+#include <array>
 #include <cmath>
 #include <optional>
 #include <type_traits>
@@ -62,9 +64,27 @@ struct IntegratorSettings {
 template <Scalar Real>
 struct NoTextures {
     explicit NoTextures(const scene::Scene&) {}
-    std::optional<Vec3<Real>> apply(SurfacePoint<Real>&, Material<Real>&, const RayCone<Real>&) const { return {}; }
+    std::optional<Vec3<Real>> apply(SurfacePoint<Real>&, const Material<Real>&, const RayCone<Real>&) const { return {}; }
     std::optional<Vec3<Real>> background(const Vec2<Real>&) const { return {}; }
 };
+
+// Whether a texture policy can change what a hit looks like: NoTextures cannot, so an
+// integrator under it reads the material in place and skips the surface's (u, v) and tangents.
+template <class Textures, class Real>
+inline constexpr bool textured = !std::is_same_v<Textures, NoTextures<Real>>;
+
+// The surface point at a hit, with (u, v) and tangents only where textures may read them, and
+// the exact point with its error bound only where rays leave by it (RayOffset::error_bound). An
+// index from outside (accel/embree.hpp) fills everything.
+template <bool Textured, Scalar Real, class Geometry>
+SurfacePoint<Real> shading_surface(const Geometry& geometry, const Ray<Real>& ray, const Hit<Real>& hit,
+                                   RayOffset offset) {
+    const bool spawn_point = offset == RayOffset::error_bound;
+    if constexpr (requires { geometry.template surface<Textured>(ray, hit, spawn_point); })
+        return geometry.template surface<Textured>(ray, hit, spawn_point);
+    else
+        return geometry.surface(ray, hit);
+}
 
 // What escaping rays see, for renderers without environment lights: the background colour for
 // primary rays, nothing for the others.
@@ -118,8 +138,10 @@ private:
         Hit<Real> hit;
         if (!intersect(ray, depth, hit)) return escaped(ray.direction, depth, path.pixel_uv);
 
-        SurfacePoint<Real> point = geometry_.surface(ray, hit);
-        Material<Real> material = materials_[point.material];
+        SurfacePoint<Real> point = shading_surface<textured<Textures, Real>>(geometry_, ray, hit, settings_.ray_offset);
+        // Textures change a copy; without them the material is read where it is stored.
+        std::conditional_t<textured<Textures, Real>, Material<Real>, const Material<Real>&> material =
+            materials_[point.material];
         travelled += hit.t;
         const RayCone<Real> cone{travelled * path.spread, std::abs(glm::dot(ray.direction, point.shading_normal))};
         if (const std::optional<Vec3<Real>> unshaded = textures_.apply(point, material, cone)) return *unshaded;
@@ -197,15 +219,43 @@ private:
                                const Material<Real>& material, Random& random) const {
         Vec3<Real> color(0);
         const Vec3<Real>& position = point.position;
+        // The error-bounded origins of this point's shadow rays, one per side they leave by
+        // (SceneGeometry::spawn_side), each computed for the first light that needs it.
+        std::array<Vec3<Real>, 4> origins;
+        unsigned known_origins = 0;
+        const auto shadow_ray = [&](const Vec3<Real>& direction) {
+            if constexpr (requires { geometry_.spawn_side(point, direction); }) {
+                if (settings_.ray_offset == RayOffset::error_bound) {
+                    const int side = geometry_.spawn_side(point, direction);
+                    if (!(known_origins & (1u << side))) {
+                        origins[std::size_t(side)] = geometry_.spawn_origin(point, direction);
+                        known_origins |= 1u << side;
+                    }
+                    return Ray<Real>{origins[std::size_t(side)], direction, Real(0), infinity<Real>, point.time};
+                }
+            }
+            return leaving(point, normal, direction, point.time);
+        };
         lights_.for_each([&](const auto& light) {
-            const LightSample<Real> sample = light.sample({position, normal}, random.uniform2<Real>());
+            // A light that takes no sample (point, directional, spot: sample(at) alone) gets none
+            // drawn, but the stream steps past its two numbers, so that every later draw is the
+            // one it was (the images stay the same).
+            const ShadingFrame<Real> at{position, normal};
+            const LightSample<Real> sample = [&] {
+                if constexpr (requires { light.sample(at); }) {
+                    random.template skip<Real>(2);
+                    return light.sample(at);
+                } else {
+                    return light.sample(at, random.uniform2<Real>());
+                }
+            }();
             const Real cos_light = glm::dot(normal, sample.direction);
             if (cos_light <= 0) return;
             // The shadow ray leaves the offset origin aimed at the light, and anything nearer than
             // the light's distance from the shading point blocks it. So a surface through the
             // light itself blocks it for every point, not by rounding (mirror_room's ceiling
             // holds a light: 20.3 dB with a per-pixel coin flip, 64.5 dB consistent).
-            Ray<Real> shadow = leaving(point, normal, sample.direction, point.time);
+            Ray<Real> shadow = shadow_ray(sample.direction);
             if (!std::isinf(sample.distance))
                 shadow.direction = unit_vector(position + sample.direction * sample.distance - shadow.origin);
             shadow.t_max = sample.distance;
@@ -222,8 +272,14 @@ private:
             // No BRDF: hw1-hw5's Blinn-Phong, kept in this form so their images stay bit-identical.
             const Vec3<Real> half_vector = unit_vector(sample.direction + to_viewer);
             const Real cos_half = std::max(glm::dot(normal, half_vector), Real(0));
-            color += (material.diffuse * cos_light + material.specular * std::pow(cos_half, material.phong_exponent)) *
-                     sample.radiance;
+            // A material without a specular colour (hw1 simple_reflectance's floor) skips the
+            // power where it is finite, a base in [0, 1] and an exponent of at least 0: the term is
+            // then specular * 0, the signed zeros the product gives (a NaN half vector, a base
+            // rounded past 1 or a negative exponent still take std::pow).
+            Vec3<Real> specular = material.specular * Real(0);
+            if (material.specular != Vec3<Real>(0) || !(cos_half <= 1) || !(material.phong_exponent >= 0))
+                specular = material.specular * std::pow(cos_half, material.phong_exponent);
+            color += (material.diffuse * cos_light + specular) * sample.radiance;
         });
         return color;
     }

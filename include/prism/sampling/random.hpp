@@ -40,7 +40,7 @@ public:
 
     constexpr std::uint32_t next_u32() {
         const std::uint64_t old = state_;
-        state_ = old * 0x5851f42d4c957f2dULL + increment_;
+        state_ = old * multiplier + increment_;
         const auto xorshifted = std::uint32_t(((old >> 18u) ^ old) >> 27u);
         const auto rotation = std::uint32_t(old >> 59u);
         return (xorshifted >> rotation) | (xorshifted << ((~rotation + 1u) & 31u));
@@ -60,10 +60,20 @@ public:
         return {u, uniform<Real>()};
     }
 
+    // Steps the stream past `count` uniform<Real>() draws without making them: a caller that
+    // needs no sample (a point light) skips its draws this way, so that every later draw
+    // (a glossy reflection's) is the one it would have been.
+    template <Scalar Real>
+    constexpr void skip(int count) {
+        const int steps = sizeof(Real) == 4 ? count : 2 * count;
+        for (int i = 0; i < steps; ++i) state_ = state_ * multiplier + increment_;
+    }
+
     // Uniform integer in [0, n) (Lemire's multiply-shift; the bias is below 2^-32 n).
     constexpr std::uint32_t below(std::uint32_t n) { return std::uint32_t((std::uint64_t(next_u32()) * n) >> 32); }
 
 private:
+    static constexpr std::uint64_t multiplier = 0x5851f42d4c957f2dULL;  // PCG's 64-bit LCG
     std::uint64_t state_ = 0;
     std::uint64_t increment_ = 1;
 };
