@@ -219,6 +219,34 @@ private:
                     found = true;
                     if constexpr (AnyHit) return true;
                 }
+            } else if (AnyHit && hits != 0) {
+                // Two or more entered, any hit: every entered leaf is tested before any inner
+                // child is descended. A shadow ray ends at its first blocker, and a leaf here is
+                // one or two packet tests, where an inner child is a subtree; the inner children
+                // are pushed in slot order (no distances: any blocker ends the ray).
+                std::uint32_t inner = 0;
+                while (hits != 0) {
+                    const int i = std::countr_zero(hits);
+                    hits &= hits - 1;
+                    if (node.count[i] == 0) {
+                        inner |= std::uint32_t(1) << i;
+                        simd::prefetch(nodes_[node.child[i]]);
+                    } else if (leaf(node.child[i], node.count[i], t_max)) {
+                        return true;
+                    }
+                }
+                if (inner != 0) {
+                    // The last inner child is descended at once, the others wait on the stack.
+                    const int last = 31 - std::countl_zero(inner);
+                    inner &= ~(std::uint32_t(1) << last);
+                    while (inner != 0) {
+                        const int i = std::countr_zero(inner);
+                        inner &= inner - 1;
+                        stack[size++] = StackEntry{node.child[i], 0, Real(0)};
+                    }
+                    current = node.child[last];
+                    continue;
+                }
             } else if (const std::uint32_t rest = hits & (hits - 1); hits != 0 && (rest & (rest - 1)) == 0) {
                 // Two children entered: one comparison orders them. The nearer is descended at
                 // once, or pushed last if it is a leaf; on a tie the second child goes first,
