@@ -266,24 +266,26 @@ private:
                 }
                 stack[size++] = StackEntry{node.child[near], node.count[near], distances[near]};
             } else if (hits != 0) {
+                // Three or more entered (closest hit): each child's place on the stack is its
+                // rank, counted with two SIMD compares against every entered distance, so the
+                // order costs no data-dependent branch (an insertion sort mispredicts on about
+                // every other move). Farther children go lower; of equal distances the lower
+                // slot goes lower, so the higher slot is popped first, as the insertion sort
+                // this replaced ordered them (which triangle wins a tie depends on the order).
                 entry_distances.store(distances);
-                // Push the entered children farthest first, so the nearest is popped next: an
-                // insertion sort into the top of the stack, at most N - 1 moves per child.
-                const int base = size;
+                const std::uint32_t entered = hits;
                 while (hits != 0) {
                     const int i = std::countr_zero(hits);
                     hits &= hits - 1;
-                    const StackEntry pushed{node.child[i], node.count[i], distances[i]};
+                    const Pack own = Pack::broadcast(distances[i]);
+                    const std::uint32_t below =
+                        ((own < entry_distances).bits() | ((own == entry_distances).bits() & ((std::uint32_t(1) << i) - 1))) &
+                        entered;
+                    StackEntry& pushed = stack[size + std::popcount(below)];
+                    pushed = StackEntry{node.child[i], node.count[i], distances[i]};
                     prefetch(pushed, touch);
-                    int slot = size++;
-                    if constexpr (!AnyHit) {
-                        while (slot > base && stack[slot - 1].distance < pushed.distance) {
-                            stack[slot] = stack[slot - 1];
-                            --slot;
-                        }
-                    }
-                    stack[slot] = pushed;
                 }
+                size += std::popcount(entered);
             }
             // Pop until an inner node to descend into; leaves on the way are tested at once.
             while (size > 0) {
