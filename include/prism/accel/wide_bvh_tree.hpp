@@ -250,7 +250,7 @@ private:
             } else if (const std::uint32_t rest = hits & (hits - 1); hits != 0 && (rest & (rest - 1)) == 0) {
                 // Two children entered: one comparison orders them. The nearer is descended at
                 // once, or pushed last if it is a leaf; on a tie the second child goes first,
-                // as the insertion sort below orders it (which triangle wins a tie depends on
+                // as the ranks below order them (which triangle wins a tie depends on
                 // the order).
                 entry_distances.store(distances);
                 const int first = std::countr_zero(hits), second = std::countr_zero(rest);
