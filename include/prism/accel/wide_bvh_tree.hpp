@@ -219,10 +219,38 @@ private:
                     found = true;
                     if constexpr (AnyHit) return true;
                 }
+            } else if (AnyHit && hits != 0) {
+                // Two or more entered, any hit: every entered leaf is tested before any inner
+                // child is descended. A shadow ray ends at its first blocker, and a leaf here is
+                // one or two packet tests, where an inner child is a subtree; the inner children
+                // are pushed in slot order (no distances: any blocker ends the ray).
+                std::uint32_t inner = 0;
+                while (hits != 0) {
+                    const int i = std::countr_zero(hits);
+                    hits &= hits - 1;
+                    if (node.count[i] == 0) {
+                        inner |= std::uint32_t(1) << i;
+                        simd::prefetch(nodes_[node.child[i]]);
+                    } else if (leaf(node.child[i], node.count[i], t_max)) {
+                        return true;
+                    }
+                }
+                if (inner != 0) {
+                    // The last inner child is descended at once, the others wait on the stack.
+                    const int last = 31 - std::countl_zero(inner);
+                    inner &= ~(std::uint32_t(1) << last);
+                    while (inner != 0) {
+                        const int i = std::countr_zero(inner);
+                        inner &= inner - 1;
+                        stack[size++] = StackEntry{node.child[i], 0, Real(0)};
+                    }
+                    current = node.child[last];
+                    continue;
+                }
             } else if (const std::uint32_t rest = hits & (hits - 1); hits != 0 && (rest & (rest - 1)) == 0) {
                 // Two children entered: one comparison orders them. The nearer is descended at
                 // once, or pushed last if it is a leaf; on a tie the second child goes first,
-                // as the insertion sort below orders it (which triangle wins a tie depends on
+                // as the ranks below order them (which triangle wins a tie depends on
                 // the order).
                 entry_distances.store(distances);
                 const int first = std::countr_zero(hits), second = std::countr_zero(rest);
@@ -238,24 +266,26 @@ private:
                 }
                 stack[size++] = StackEntry{node.child[near], node.count[near], distances[near]};
             } else if (hits != 0) {
+                // Three or more entered (closest hit): each child's place on the stack is its
+                // rank, counted with two SIMD compares against every entered distance, so the
+                // order costs no data-dependent branch (an insertion sort mispredicts on about
+                // every other move). Farther children go lower; of equal distances the lower
+                // slot goes lower, so the higher slot is popped first, as the insertion sort
+                // this replaced ordered them (which triangle wins a tie depends on the order).
                 entry_distances.store(distances);
-                // Push the entered children farthest first, so the nearest is popped next: an
-                // insertion sort into the top of the stack, at most N - 1 moves per child.
-                const int base = size;
+                const std::uint32_t entered = hits;
                 while (hits != 0) {
                     const int i = std::countr_zero(hits);
                     hits &= hits - 1;
-                    const StackEntry pushed{node.child[i], node.count[i], distances[i]};
+                    const Pack own = Pack::broadcast(distances[i]);
+                    const std::uint32_t below =
+                        ((own < entry_distances).bits() | ((own == entry_distances).bits() & ((std::uint32_t(1) << i) - 1))) &
+                        entered;
+                    StackEntry& pushed = stack[size + std::popcount(below)];
+                    pushed = StackEntry{node.child[i], node.count[i], distances[i]};
                     prefetch(pushed, touch);
-                    int slot = size++;
-                    if constexpr (!AnyHit) {
-                        while (slot > base && stack[slot - 1].distance < pushed.distance) {
-                            stack[slot] = stack[slot - 1];
-                            --slot;
-                        }
-                    }
-                    stack[slot] = pushed;
                 }
+                size += std::popcount(entered);
             }
             // Pop until an inner node to descend into; leaves on the way are tested at once.
             while (size > 0) {
