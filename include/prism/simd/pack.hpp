@@ -145,6 +145,26 @@ private:
 
 #endif
 
+// |a| and the larger of a and b (either, where one is NaN), lane by lane.
+template <class T, int N>
+PRISM_SIMD_INLINE inline Pack<T, N> abs(Pack<T, N> a) {
+#ifdef PRISM_SIMD_STDX
+    return {stdx::abs(a.native)};
+#else
+    for (T& lane : a.lanes) lane = lane < T(0) ? -lane : lane;
+    return a;
+#endif
+}
+template <class T, int N>
+PRISM_SIMD_INLINE inline Pack<T, N> max(Pack<T, N> a, Pack<T, N> b) {
+#ifdef PRISM_SIMD_STDX
+    return {stdx::max(a.native, b.native)};
+#else
+    for (int i = 0; i < N; ++i) a.lanes[i] = a.lanes[i] < b.lanes[i] ? b.lanes[i] : a.lanes[i];
+    return a;
+#endif
+}
+
 // a > b ? a : b and a < b ? a : b, lane by lane: a NaN in `a` leaves `b`, which is what the
 // slab test needs (a NaN slab distance, 0 * inf on a slab plane, constrains nothing).
 template <class T, int N>
