@@ -131,6 +131,9 @@ public:
         bool found = false;
         for (std::uint32_t base = first; base < first + count; base += N) {
             if constexpr (filtered) {
+                // The double packet is requested before the filter runs: where the filter keeps
+                // a lane, its wait overlaps the filter's instead of following it.
+                simd::prefetch(packets_[base / N]);
                 if ((filter(filters_[base / N], ray) & lane_mask(first + count - base)) == 0) continue;
             }
             alignas(64) Storage t[N], b1[N], b2[N];
@@ -156,13 +159,11 @@ public:
         return found;
     }
 
-    // Requests the packet that holds slot `first` (a leaf's first slot) from memory: for a
-    // double packet the filter's, the one read first and often the only one.
+    // Requests the packet that holds slot `first` (a leaf's first slot) from memory, and for a
+    // double packet the filter's copy too.
     void prefetch(std::uint32_t first) const {
-        if constexpr (filtered)
-            simd::prefetch(filters_[first / N]);
-        else
-            simd::prefetch(packets_[first / N]);
+        if constexpr (filtered) simd::prefetch(filters_[first / N]);
+        simd::prefetch(packets_[first / N]);
     }
 
     // For tests of the filter: the lanes of the packet holding slot `first` that the filter
@@ -182,6 +183,9 @@ public:
     [[gnu::always_inline]] bool occluded(const PackedRay& ray, std::uint32_t first, std::uint32_t count, Real t_min, Real t_limit) const {
         for (std::uint32_t base = first; base < first + count; base += N) {
             if constexpr (filtered) {
+                // The double packet is requested before the filter runs: where the filter keeps
+                // a lane, its wait overlaps the filter's instead of following it.
+                simd::prefetch(packets_[base / N]);
                 if ((filter(filters_[base / N], ray) & lane_mask(first + count - base)) == 0) continue;
             }
             alignas(64) Storage t[N], b1[N], b2[N];
@@ -256,7 +260,7 @@ private:
         const F v = ax * cy - ay * cx;
         const F w = bx * ay - by * ax;
         using simd::abs;
-        using simd::max;
+        const auto max = [](F a, F b) { return simd::max_keep(a, b); };
         const F m = max(max(max(abs(ax), abs(ay)), max(abs(bx), abs(by))), max(abs(cx), abs(cy)));
         const F d = F::load(packet.magnitude) + f.magnitude;
         const F delta = d * F::broadcast(12 * unit_roundoff<float>) + F::broadcast(0x1p-126f);

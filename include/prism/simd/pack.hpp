@@ -11,6 +11,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 #if !defined(PRISM_SIMD_SCALAR) && defined(__GLIBCXX__) && __has_include(<experimental/simd>)
@@ -145,31 +146,43 @@ private:
 
 #endif
 
-// |a| and the larger of a and b (either, where one is NaN), lane by lane.
+// |a|, lane by lane.
 template <class T, int N>
 PRISM_SIMD_INLINE inline Pack<T, N> abs(Pack<T, N> a) {
 #ifdef PRISM_SIMD_STDX
     return {stdx::abs(a.native)};
 #else
-    for (T& lane : a.lanes) lane = lane < T(0) ? -lane : lane;
+    for (T& lane : a.lanes) lane = std::fabs(lane);
     return a;
 #endif
 }
-template <class T, int N>
-PRISM_SIMD_INLINE inline Pack<T, N> max(Pack<T, N> a, Pack<T, N> b) {
-#ifdef PRISM_SIMD_STDX
-    return {stdx::max(a.native, b.native)};
-#else
-    for (int i = 0; i < N; ++i) a.lanes[i] = a.lanes[i] < b.lanes[i] ? b.lanes[i] : a.lanes[i];
-    return a;
-#endif
-}
-
 // a > b ? a : b and a < b ? a : b, lane by lane: a NaN in `a` leaves `b`, which is what the
 // slab test needs (a NaN slab distance, 0 * inf on a slab plane, constrains nothing).
+// With stdx, written as the vector ternary on the native vectors, which GCC turns into one
+// vmaxps/vmaxpd (vminps/vminpd): x86's max(a, b) is exactly a > b ? a : b, NaN and signed
+// zeros included, so the bits are the select's. The select took a compare into a mask and a
+// blend, two instructions per register, six pairs per node in the slab test. A Pack of
+// several registers (fixed_size: 8 floats under SSE) keeps the select. (stdx::max
+// is not used: libstdc++ compiles it under finite-math-only, which may swap the operands.)
 template <class T, int N>
-PRISM_SIMD_INLINE inline Pack<T, N> max_keep(Pack<T, N> a, Pack<T, N> b) { return select(a > b, a, b); }
+PRISM_SIMD_INLINE inline Pack<T, N> max_keep(Pack<T, N> a, Pack<T, N> b) {
+#ifdef PRISM_SIMD_STDX
+    if constexpr (requires { stdx::__data(a.native)._M_data; }) {  // one register, not a tuple of them
+        const auto x = stdx::__data(a.native)._M_data, y = stdx::__data(b.native)._M_data;
+        return {typename Pack<T, N>::Native(x > y ? x : y)};
+    }
+#endif
+    return select(a > b, a, b);
+}
 template <class T, int N>
-PRISM_SIMD_INLINE inline Pack<T, N> min_keep(Pack<T, N> a, Pack<T, N> b) { return select(a < b, a, b); }
+PRISM_SIMD_INLINE inline Pack<T, N> min_keep(Pack<T, N> a, Pack<T, N> b) {
+#ifdef PRISM_SIMD_STDX
+    if constexpr (requires { stdx::__data(a.native)._M_data; }) {  // one register, not a tuple of them
+        const auto x = stdx::__data(a.native)._M_data, y = stdx::__data(b.native)._M_data;
+        return {typename Pack<T, N>::Native(x < y ? x : y)};
+    }
+#endif
+    return select(a < b, a, b);
+}
 
 }  // namespace prism::simd
