@@ -11,7 +11,6 @@
 #pragma once
 
 #include <array>
-#include <cmath>
 #include <cstdint>
 
 #if !defined(PRISM_SIMD_SCALAR) && defined(__GLIBCXX__) && __has_include(<experimental/simd>)
@@ -146,16 +145,6 @@ private:
 
 #endif
 
-// |a|, lane by lane.
-template <class T, int N>
-PRISM_SIMD_INLINE inline Pack<T, N> abs(Pack<T, N> a) {
-#ifdef PRISM_SIMD_STDX
-    return {stdx::abs(a.native)};
-#else
-    for (T& lane : a.lanes) lane = std::fabs(lane);
-    return a;
-#endif
-}
 // a > b ? a : b and a < b ? a : b, lane by lane: a NaN in `a` leaves `b`, which is what the
 // slab test needs (a NaN slab distance, 0 * inf on a slab plane, constrains nothing).
 // With stdx, written as the vector ternary on the native vectors, which GCC turns into one
