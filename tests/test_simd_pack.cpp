@@ -1,4 +1,5 @@
-// simd/pack.hpp: the lane operations whose exact IEEE behaviour the wide BVH's slab test relies on.
+// simd/pack.hpp: max_keep and min_keep, whose exact IEEE behaviour the wide BVH's slab test relies on
+// (a NaN distance constrains nothing). A faster form must keep these bits.
 #include <prism/simd/pack.hpp>
 
 #include <doctest/doctest.h>

@@ -147,31 +147,9 @@ private:
 
 // a > b ? a : b and a < b ? a : b, lane by lane: a NaN in `a` leaves `b`, which is what the
 // slab test needs (a NaN slab distance, 0 * inf on a slab plane, constrains nothing).
-// With stdx, written as the vector ternary on the native vectors, which GCC turns into one
-// vmaxps/vmaxpd (vminps/vminpd): x86's max(a, b) is exactly a > b ? a : b, NaN and signed
-// zeros included, so the bits are the select's. The select took a compare into a mask and a
-// blend, two instructions per register, six pairs per node in the slab test. A Pack of
-// several registers (fixed_size: 8 floats under SSE) keeps the select. (stdx::max
-// is not used: libstdc++ compiles it under finite-math-only, which may swap the operands.)
 template <class T, int N>
-PRISM_SIMD_INLINE inline Pack<T, N> max_keep(Pack<T, N> a, Pack<T, N> b) {
-#ifdef PRISM_SIMD_STDX
-    if constexpr (requires { stdx::__data(a.native)._M_data; }) {  // one register, not a tuple of them
-        const auto x = stdx::__data(a.native)._M_data, y = stdx::__data(b.native)._M_data;
-        return {typename Pack<T, N>::Native(x > y ? x : y)};
-    }
-#endif
-    return select(a > b, a, b);
-}
+PRISM_SIMD_INLINE inline Pack<T, N> max_keep(Pack<T, N> a, Pack<T, N> b) { return select(a > b, a, b); }
 template <class T, int N>
-PRISM_SIMD_INLINE inline Pack<T, N> min_keep(Pack<T, N> a, Pack<T, N> b) {
-#ifdef PRISM_SIMD_STDX
-    if constexpr (requires { stdx::__data(a.native)._M_data; }) {  // one register, not a tuple of them
-        const auto x = stdx::__data(a.native)._M_data, y = stdx::__data(b.native)._M_data;
-        return {typename Pack<T, N>::Native(x < y ? x : y)};
-    }
-#endif
-    return select(a < b, a, b);
-}
+PRISM_SIMD_INLINE inline Pack<T, N> min_keep(Pack<T, N> a, Pack<T, N> b) { return select(a < b, a, b); }
 
 }  // namespace prism::simd
