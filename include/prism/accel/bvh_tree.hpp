@@ -311,20 +311,26 @@ private:
                 }
             }
             // Inlined by force: GCC kept it a call, and the box then went through the stack.
+            // Without MarkOccupied, `occupied` is left for merge to find from the counts: in a
+            // large node that is a few dozen tests per node instead of three per primitive.
+            template <bool MarkOccupied = true>
             [[gnu::always_inline]] void add(const BuildBox& box, const Bins& bin) {
                 for (int axis = 0; axis < 3; ++axis) {
                     bounds[axis][bin[axis]].extend(box);
                     ++counts[axis][bin[axis]];
-                    occupied[axis] |= std::uint64_t(1) << bin[axis];
+                    if constexpr (MarkOccupied) occupied[axis] |= std::uint64_t(1) << bin[axis];
                 }
             }
+            // Adds other's bins to these, and marks the bins that hold a primitive.
             void merge(const BinSet& other, int bin_count) {
                 for (int axis = 0; axis < 3; ++axis) {
+                    std::uint64_t mask = 0;
                     for (int b = 0; b < bin_count; ++b) {
                         bounds[axis][b].extend(other.bounds[axis][b]);
                         counts[axis][b] += other.counts[axis][b];
+                        mask |= std::uint64_t(counts[axis][b] != 0) << b;
                     }
-                    occupied[axis] |= other.occupied[axis];
+                    occupied[axis] = mask;
                 }
             }
         };
@@ -386,10 +392,10 @@ private:
                 odd_bins.reset(bin_count);
                 std::uint32_t i = 0;
                 for (; i + 1 < count; i += 2) {
-                    bins.add(range[i], bins_of(range[i]));
-                    odd_bins.add(range[i + 1], bins_of(range[i + 1]));
+                    bins.add<false>(range[i], bins_of(range[i]));
+                    odd_bins.add<false>(range[i + 1], bins_of(range[i + 1]));
                 }
-                if (i < count) bins.add(range[i], bins_of(range[i]));
+                if (i < count) bins.add<false>(range[i], bins_of(range[i]));
                 bins.merge(odd_bins, bin_count);
             } else {
                 for (std::uint32_t i = 0; i < count; ++i) bins.add(range[i], bins_of(range[i]));
@@ -457,17 +463,25 @@ private:
                 if (count <= options.max_leaf_size && leaf_cost <= split_cost) return make_leaf(node, begin, end);
                 // The children's centroid bounds, gathered lane by lane as the partition sees
                 // each box (the same minima and maxima Aabb::extend would find), indexed by
-                // side rather than chosen by a branch the data would mispredict.
-                std::array<BuildBox, 2> centroid_lanes{BuildBox::empty(), BuildBox::empty()};  // right, left
-                const auto goes_left = [&](const BuildBox& box) __attribute__((always_inline)) {
+                // side rather than chosen by a branch the data would mispredict. Even and odd
+                // primitives keep separate bounds, merged afterwards, as the bins do: with one
+                // pair, a run of primitives on one side waited for each other's store (the
+                // loop's hottest instruction on the dragon). The lanes that matter take the same
+                // values in either order; only the sign of a zero bound may differ, and
+                // (c - low) * scale bins a centroid the same for +0 and -0.
+                std::array<BuildBox, 4> centroid_lanes;  // [2 * odd + left]
+                centroid_lanes.fill(BuildBox::empty());
+                const auto goes_left = [&](const BuildBox& box, std::uint32_t odd) __attribute__((always_inline)) {
                     Lanes centroid, position;
                     box.centroid(centroid);
                     bin_positions(centroid, position);
                     const bool left = std::min(bin_count - 1, int(position[best_axis])) < best_split;
-                    centroid_lanes[left].extend(centroid);
+                    centroid_lanes[2 * odd + left].extend(centroid);
                     return left;
                 };
                 middle = begin + partition(begin, end, goes_left);
+                centroid_lanes[0].extend(centroid_lanes[2]);
+                centroid_lanes[1].extend(centroid_lanes[3]);
                 left_centroids = centroid_lanes[1].aabb();
                 right_centroids = centroid_lanes[0].aabb();
             }
@@ -487,7 +501,8 @@ private:
         }
 
         // Moves the primitives of [begin, end) for which goes_left holds to the front, boxes and
-        // indices together, and returns how many there are; goes_left sees each primitive once.
+        // indices together, and returns how many there are; goes_left(box, odd) sees each primitive
+        // once, odd telling the parity of its place (for the caller's two sets of bounds).
         // The swaps are those of libstdc++'s std::partition, which this builder used before, so
         // the primitive order is unchanged. Hoare's scheme from both ends swaps the k-th
         // primitive from the front that goes right with the k-th from the back that goes left,
@@ -508,12 +523,15 @@ private:
                 sides = shared_sides + begin;
                 moves = shared_moves + begin;
             }
+            // In a local: a store to sides (bytes, which may alias anything) made the compiler
+            // reload the member before every box.
+            BuildBox* const range = boxes + begin;
             std::uint32_t left_count = 0;
             for (std::uint32_t i = 0; i < count; ++i) {
                 // Large nodes stream their boxes from memory, and this loop's chain of side-indexed
                 // updates leaves the hardware prefetcher behind: ask half a kilobyte ahead.
-                simd::prefetch(boxes[begin + std::min(i + 16, count - 1)]);
-                const bool left = goes_left(boxes[begin + i]);
+                simd::prefetch(range[std::min(i + 16, count - 1)]);
+                const bool left = goes_left(range[i], i & 1u);
                 sides[i] = left;
                 left_count += left;
             }
@@ -531,7 +549,7 @@ private:
                 found += sides[i];
             }
             for (std::uint32_t k = 0; k < misplaced; ++k) {
-                std::swap(boxes[begin + moves[k]], boxes[begin + from_back[k]]);
+                std::swap(range[moves[k]], range[from_back[k]]);
                 std::swap(indices[begin + moves[k]], indices[begin + from_back[k]]);
             }
             return left_count;
