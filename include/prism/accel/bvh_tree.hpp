@@ -268,12 +268,13 @@ private:
             const Real x = max[0] - min[0], y = max[1] - min[1], z = max[2] - min[2];
             return x * y + y * z + z * x;
         }
+        // Written as constants: filled lane by lane, GCC rebuilt the two vectors with four
+        // inserts each for every bin a node resets (6% of the builder's time on the dragon).
         static BuildBox empty() {
+            constexpr Real high = infinity<Real>;
             BuildBox made;
-            for (int k = 0; k < 4; ++k) {
-                made.min[k] = infinity<Real>;
-                made.max[k] = -infinity<Real>;
-            }
+            made.min = Lanes{high, high, high, high};
+            made.max = Lanes{-high, -high, -high, -high};
             return made;
         }
     };
