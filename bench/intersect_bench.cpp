@@ -326,18 +326,28 @@ void build_prism(benchmark::State& state, const Workload& workload) {
 // like prism's, with RTC_SCENE_FLAG_ROBUST off or on.
 #ifdef PRISM_BENCH_WITH_EMBREE
 
+RTCDevice make_embree_device(const char* config) {
+    RTCDevice made = rtcNewDevice(config);
+    if (made == nullptr) throw std::runtime_error("rtcNewDevice failed");
+    return made;
+}
+
+// One thread, as prism's builds are timed (the ray queries never use more).
 RTCDevice embree_device() {
-    static RTCDevice device = [] {
-        // One thread, as prism's builds are timed (the ray queries never use more).
-        RTCDevice made = rtcNewDevice("threads=1");
-        if (made == nullptr) throw std::runtime_error("rtcNewDevice failed");
-        return made;
-    }();
+    static RTCDevice device = make_embree_device("threads=1");
     return device;
 }
 
-RTCScene build_embree_scene(const scene::Scene& scene, bool robust) {
-    RTCDevice device = embree_device();
+// Two threads, for the build's scaling (build_threads/). Made only when that benchmark runs:
+// Embree caps TBB's parallelism for the whole process at the largest thread count of its live
+// devices (a tbb::global_control it holds), so while only the one-thread device lives, no TBB
+// work in this process, prism's included, runs on more than one thread.
+RTCDevice embree_device_two_threads() {
+    static RTCDevice device = make_embree_device("threads=2");
+    return device;
+}
+
+RTCScene build_embree_scene(const scene::Scene& scene, bool robust, RTCDevice device = embree_device()) {
     RTCScene embree_scene = rtcNewScene(device);
     rtcSetSceneFlags(embree_scene, robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
     for (const scene::Mesh& mesh : scene.meshes) {
@@ -536,6 +546,93 @@ void build_benchmark(benchmark::State& state, WorkloadGetter get, const Variant&
     state.counters["triangles"] = double(workload.triangle_count);
 }
 
+double wall_seconds() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+double process_cpu_seconds() {
+    timespec now;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
+    return double(now.tv_sec) + 1e-9 * double(now.tv_nsec);
+}
+
+// Whether the parallel build scales: prism's default float structure and Embree's default
+// build, each on one and on two threads, timed in interleaved rounds (a new random order each
+// round) by the wall clock, which is what a second thread can lower, and by the process's CPU
+// time, which says what the second thread costs in work. Ratios are taken within a round and
+// their median over rounds reported. On a machine whose other jobs keep both cores busy a
+// second thread has no core to run on, so the CPU columns (and `uptime`) must be read with it.
+constexpr int scaling_rounds = 9;
+
+void build_scaling_benchmark(benchmark::State& state, WorkloadGetter get) {
+    const Workload& workload = get();
+    if (!workload.error.empty()) return state.SkipWithError(workload.error.c_str());
+    using DefaultFloat = DefaultAcceleration<prism::Precision::single>;
+    struct Contender {
+        const char* name;
+        int threads;
+        std::function<void()> build;
+        std::vector<double> wall, cpu;
+    };
+    std::vector<Contender> contenders;
+    for (const int threads : {1, 2})
+        contenders.push_back({"prism", threads, [&workload] {
+                                  const prism::SceneGeometry<float, DefaultFloat> geometry(workload.scene);
+                                  benchmark::DoNotOptimize(geometry.bounds());
+                              }, {}, {}});
+#ifdef PRISM_BENCH_WITH_EMBREE
+    contenders.push_back({"embree", 1, [&workload] { rtcReleaseScene(build_embree_scene(workload.scene, false)); }, {}, {}});
+    contenders.push_back({"embree", 2, [&workload] {
+                              rtcReleaseScene(build_embree_scene(workload.scene, false, embree_device_two_threads()));
+                          }, {}, {}});
+#endif
+    std::vector<std::size_t> order(contenders.size());
+    std::iota(order.begin(), order.end(), std::size_t(0));
+    std::mt19937 random(2026);
+    for (Contender& contender : contenders) {  // untimed: the devices, the allocator's first pages
+        const tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(contender.threads));
+        contender.build();
+    }
+    for (auto _ : state) {
+        for (int round = 0; round < scaling_rounds; ++round) {
+            std::shuffle(order.begin(), order.end(), random);
+            for (const std::size_t c : order) {
+                Contender& contender = contenders[c];
+                const tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
+                                                  std::size_t(contender.threads));
+                const double wall = wall_seconds(), cpu = process_cpu_seconds();
+                contender.build();
+                contender.cpu.push_back(process_cpu_seconds() - cpu);
+                contender.wall.push_back(wall_seconds() - wall);
+            }
+        }
+    }
+    const auto median = [](std::vector<double> values) {
+        std::sort(values.begin(), values.end());
+        return values[values.size() / 2];
+    };
+    const auto ratio = [&](const Contender& a, const Contender& b, bool wall) {
+        std::vector<double> ratios;
+        for (std::size_t round = 0; round < a.wall.size(); ++round)
+            ratios.push_back(wall ? a.wall[round] / b.wall[round] : a.cpu[round] / b.cpu[round]);
+        return median(ratios);
+    };
+    for (const Contender& contender : contenders) {
+        const std::string name = std::string(contender.name) + "_" + std::to_string(contender.threads) + "t";
+        state.counters[name + "_wall_ms"] = 1e3 * median(contender.wall);
+        state.counters[name + "_cpu_ms"] = 1e3 * median(contender.cpu);
+    }
+    // Two threads over one, and prism over Embree at each thread count, by wall clock.
+    state.counters["prism_2t/1t"] = ratio(contenders[1], contenders[0], true);
+    if (contenders.size() == 4) {
+        state.counters["embree_2t/1t"] = ratio(contenders[3], contenders[2], true);
+        state.counters["prism/embree_1t"] = ratio(contenders[0], contenders[2], true);
+        state.counters["prism/embree_2t"] = ratio(contenders[1], contenders[3], true);
+        state.counters["prism/embree_1t_cpu"] = ratio(contenders[0], contenders[2], false);
+    }
+    state.counters["triangles"] = double(workload.triangle_count);
+}
+
 // The ratios, measured in pairs: on a shared machine the load drifts between one benchmark
 // and the next, so separate benchmarks' medians compare different machines. Here every round
 // traces the batch once with each variant, in a new random order, timed by the thread's CPU
@@ -724,6 +821,11 @@ void register_benchmarks() {
                 ->Unit(benchmark::kMillisecond)
                 ->MeasureProcessCPUTime();
         }
+        benchmark::RegisterBenchmark((std::string("build_threads/") + workload).c_str(),
+                                     [getter = getter](benchmark::State& state) { build_scaling_benchmark(state, getter); })
+            ->Iterations(1)
+            ->Repetitions(1)
+            ->Unit(benchmark::kSecond);
     }
 }
 

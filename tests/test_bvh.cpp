@@ -8,19 +8,23 @@
 #include <prism/accel/accelerator.hpp>
 #include <prism/geometry/scene_geometry.hpp>
 #include <prism/io/ply.hpp>
+#include <prism/memory/huge_page_allocator.hpp>
 
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <doctest/doctest.h>
 #include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <map>
+#include <numeric>
 #include <random>
 #include <set>
 #include <sstream>
@@ -658,6 +662,71 @@ TEST_CASE_TEMPLATE("BVH stopped at the leaf size: the leaves the full build's co
             different += leaves[i].primitives != expected[i].primitives || leaves[i].bounds.min != expected[i].bounds.min ||
                          leaves[i].bounds.max != expected[i].bounds.max;
         CHECK(different == 0);
+    }
+}
+
+TEST_CASE_TEMPLATE("BVH built from a box function: the same trees as from an array of boxes", Real, float, double) {
+    // TriangleMesh hands its boxes to the index as it makes them (build(count, box_of)); the
+    // trees must be those of the array form, node for node. One thread: the parallel build
+    // numbers nodes in the order its tasks run.
+    const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+    std::vector<glm::dvec3> positions;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    perturbed_sphere(5, 11, positions, triangles);  // 20,480 triangles: the large nodes' scratch too
+    const auto boxes = triangle_boxes<Real>(positions, triangles);
+    std::vector<std::uint32_t> asked;
+    const auto box_of = [&](std::uint32_t i) {
+        asked.push_back(i);
+        return boxes[i];
+    };
+    const auto same_box = [](const prism::Aabb<Real>& a, const prism::Aabb<Real>& b) { return a.min == b.min && a.max == b.max; };
+    {
+        const auto from_array = prism::BvhTree<Real>::build(boxes);
+        const auto from_function = prism::BvhTree<Real>::build(std::uint32_t(boxes.size()), box_of);
+        std::vector<std::uint32_t> in_order(boxes.size());
+        std::iota(in_order.begin(), in_order.end(), 0u);
+        CHECK(asked == in_order);  // once each, in order
+        REQUIRE(from_function.nodes().size() == from_array.nodes().size());
+        std::size_t different = 0;
+        for (std::size_t i = 0; i < from_array.nodes().size(); ++i) {
+            const auto &a = from_array.nodes()[i], &b = from_function.nodes()[i];
+            different += !same_box(a.bounds, b.bounds) || a.index != b.index || a.count != b.count;
+        }
+        CHECK(different == 0);
+        CHECK(from_function.primitive_indices() == from_array.primitive_indices());
+    }
+    const auto check_wide = [&]<int N>(std::integral_constant<int, N>) {
+        const auto from_array = prism::WideBvhTree<Real, N>::build(boxes);
+        const auto from_function = prism::WideBvhTree<Real, N>::build(std::uint32_t(boxes.size()), box_of);
+        REQUIRE(from_function.nodes().size() == from_array.nodes().size());
+        std::size_t different = 0;  // field by field: a node of double lanes has padding
+        for (std::size_t i = 0; i < from_array.nodes().size(); ++i) {
+            const auto &a = from_array.nodes()[i], &b = from_function.nodes()[i];
+            different += std::memcmp(a.bounds, b.bounds, sizeof a.bounds) != 0 || std::memcmp(a.child, b.child, sizeof a.child) != 0 ||
+                         std::memcmp(a.count, b.count, sizeof a.count) != 0;
+        }
+        CHECK(different == 0);
+        CHECK(from_function.primitive_indices() == from_array.primitive_indices());
+        CHECK(same_box(from_function.bounds(), from_array.bounds()));
+    };
+    check_wide(std::integral_constant<int, 4>{});
+    check_wide(std::integral_constant<int, 8>{});
+}
+
+TEST_CASE("HugePageAllocator: aligned for its type below and above a huge page, huge-page aligned above") {
+    // The builder's boxes of double lanes ask for 32 bytes, more than operator new's default.
+    struct alignas(32) Wide {
+        double lanes[4];
+    };
+    for (const std::size_t count : {std::size_t(3), std::size_t(1000), std::size_t(200000)}) {
+        CAPTURE(count);
+        std::vector<Wide, prism::HugePageAllocator<Wide>> array(count);
+        const auto address = reinterpret_cast<std::uintptr_t>(array.data());
+        CHECK(address % alignof(Wide) == 0);
+        if (count * sizeof(Wide) >= prism::HugePageAllocator<Wide>::huge_page)
+            CHECK(address % prism::HugePageAllocator<Wide>::huge_page == 0);
+        for (std::size_t i = 0; i < count; ++i) array[i].lanes[0] = double(i);  // every byte is ours
+        CHECK(array[count - 1].lanes[0] == double(count - 1));
     }
 }
 

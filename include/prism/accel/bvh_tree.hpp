@@ -6,6 +6,7 @@
 
 #include <prism/geometry/aabb.hpp>
 #include <prism/math/floating_point.hpp>
+#include <prism/memory/huge_page_allocator.hpp>
 #include <prism/simd/prefetch.hpp>
 
 #include <tbb/parallel_invoke.h>
@@ -19,6 +20,7 @@
 #include <memory>
 #include <numeric>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 namespace prism {
@@ -51,28 +53,50 @@ public:
     BvhTree() = default;
 
     static BvhTree build(std::span<const Aabb<Real>> boxes, const BvhBuildOptions& options = {}) {
+        return build(static_cast<std::uint32_t>(boxes.size()), [boxes](std::uint32_t i) { return boxes[i]; }, options);
+    }
+
+    // The same from `box_of(i)`, the box of primitive i, asked once per primitive in order: a
+    // caller that makes its boxes (a mesh from its triangles) hands them straight to the
+    // builder's own array instead of filling one of its own first (on the 766k-triangle dragon
+    // an 18 MB array written, faulted in and read back once).
+    template <class BoxOf>
+        requires std::is_invocable_r_v<Aabb<Real>, const BoxOf&, std::uint32_t>
+    static BvhTree build(std::uint32_t count, const BoxOf& box_of, const BvhBuildOptions& options = {}) {
         BvhTree tree;
-        const auto count = static_cast<std::uint32_t>(boxes.size());
         tree.primitive_indices_.resize(count);
         std::iota(tree.primitive_indices_.begin(), tree.primitive_indices_.end(), 0u);
         if (count == 0) return tree;
-        std::vector<BuildBox> build_boxes(count);
+        // The builder's arrays are written whole before they are read, so they are not cleared,
+        // and come in huge pages: fresh memory's page faults in 4 kB pages were a tenth of the
+        // dragon's build.
+        Array<BuildBox> build_boxes(count);
         Aabb<Real> root_bounds, centroid_bounds;
         for (std::uint32_t i = 0; i < count; ++i) {
-            build_boxes[i] = BuildBox::of(boxes[i]);
-            root_bounds.extend(boxes[i]);
-            centroid_bounds.extend(boxes[i].centroid());
+            const Aabb<Real> box = box_of(i);
+            build_boxes[i] = BuildBox::of(box);
+            root_bounds.extend(box);
+            centroid_bounds.extend(box.centroid());
         }
         // A tree has at most 2 count - 1 nodes, but leaves of several primitives make far fewer.
         // The builder writes into storage of the bound left uninitialised, and only the nodes
         // made are copied out: the pages of the unused part are never touched (initialising
         // them, and copying to shrink afterwards, cost a tenth of the dragon's build in page
-        // faults). Every node is written before it is read; the bytes become BvhNodes the way
-        // any storage from new std::byte[] does (C++20 implicit object creation).
-        const auto storage = std::make_unique_for_overwrite<std::byte[]>((2 * std::size_t(count) - 1) * sizeof(BvhNode<Real>));
-        BvhNode<Real>* const nodes = reinterpret_cast<BvhNode<Real>*>(storage.get());
+        // faults). Every node is written before it is read; the storage of an allocation
+        // function holds BvhNodes (an aggregate) as soon as they are written (C++20 implicit
+        // object creation).
+        const std::size_t capacity = 2 * std::size_t(count) - 1;
+        const auto release = [capacity](BvhNode<Real>* nodes) { HugePageAllocator<BvhNode<Real>>().deallocate(nodes, capacity); };
+        const std::unique_ptr<BvhNode<Real>[], decltype(release)> storage(HugePageAllocator<BvhNode<Real>>().allocate(capacity),
+                                                                        release);
+        BvhNode<Real>* const nodes = storage.get();
         nodes[0] = {root_bounds, 0, 0};
-        Builder builder{build_boxes, tree.primitive_indices_, nodes, options, {1}};
+        // The large nodes' partition scratch, one byte and one index per primitive, made once:
+        // a node uses the slots of its own range, which no node being partitioned at the same
+        // time shares (a parallel subtree starts after its parent's partition has ended).
+        Array<std::uint8_t> sides(count > Builder::scratch_on_stack ? count : 0);
+        Array<std::uint32_t> moves(sides.size());
+        Builder builder{build_boxes.data(), tree.primitive_indices_, nodes, options, {1}, sides.data(), moves.data()};
         builder.build(0, 0, count, centroid_bounds, 0);
         tree.nodes_.assign(nodes, nodes + builder.node_count.load());
         return tree;
@@ -169,11 +193,21 @@ private:
     // (-Wpsabi) where AVX is not enabled.
 #if defined(__GNUC__) || defined(__clang__)
     typedef Real Lanes __attribute__((vector_size(4 * sizeof(Real))));
+    typedef int Bins __attribute__((vector_size(4 * sizeof(int))));
     static void keep_min(Lanes& into, const Lanes& x) { into = x < into ? x : into; }
     static void keep_max(Lanes& into, const Lanes& x) { into = into < x ? x : into; }
     static void half_sum(const Lanes& a, const Lanes& b, Lanes& out) { out = (a + b) * Real(0.5); }
     static void shift_scale(const Lanes& x, const Lanes& shift, const Lanes& scale, Lanes& out) {
         out = (x - shift) * scale;
+    }
+    // int(position) lane by lane, clamped to [0, last]: one truncating conversion (cvttps2dq,
+    // or cvttpd2dq for double) and two integer clamps for the three axes, where the scalar form
+    // took three conversions and six clamps. x86 converts NaN and out-of-range values to
+    // INT_MIN in both forms, which the clamp sends to bin 0.
+    static void bins_at(const Lanes& position, int last, Bins& out) {
+        out = __builtin_convertvector(position, Bins);
+        out = out < last ? out : last;
+        out = out > 0 ? out : 0;
     }
 #else
     using Lanes = std::array<Real, 4>;
@@ -188,6 +222,12 @@ private:
     }
     static void shift_scale(const Lanes& x, const Lanes& shift, const Lanes& scale, Lanes& out) {
         for (int k = 0; k < 4; ++k) out[k] = (x[k] - shift[k]) * scale[k];
+    }
+    using Bins = std::array<int, 4>;
+    static void bins_at(const Lanes& position, int last, Bins& out) {
+        for (int k = 0; k < 4; ++k) out[k] = int(position[k]);
+        for (int k = 0; k < 4; ++k) out[k] = out[k] < last ? out[k] : last;
+        for (int k = 0; k < 4; ++k) out[k] = out[k] > 0 ? out[k] : 0;
     }
 #endif
 
@@ -228,22 +268,29 @@ private:
             const Real x = max[0] - min[0], y = max[1] - min[1], z = max[2] - min[2];
             return x * y + y * z + z * x;
         }
+        // Written as constants: filled lane by lane, GCC rebuilt the two vectors with four
+        // inserts each for every bin a node resets (6% of the builder's time on the dragon).
         static BuildBox empty() {
+            constexpr Real high = infinity<Real>;
             BuildBox made;
-            for (int k = 0; k < 4; ++k) {
-                made.min[k] = infinity<Real>;
-                made.max[k] = -infinity<Real>;
-            }
+            made.min = Lanes{high, high, high, high};
+            made.max = Lanes{-high, -high, -high, -high};
             return made;
         }
     };
 
+    template <class T>
+    using Array = std::vector<T, HugePageAllocator<T>>;
+
     struct Builder {
-        std::vector<BuildBox>& boxes;  // in the order of indices
+        BuildBox* boxes;  // in the order of indices
         std::vector<std::uint32_t>& indices;
         BvhNode<Real>* nodes;  // room for 2 count - 1
         const BvhBuildOptions& options;
         std::atomic<std::uint32_t> node_count;
+        std::uint8_t* shared_sides;     // the partition's scratch for nodes too large for the stack
+        std::uint32_t* shared_moves;  // (count slots each: see partition)
+        static constexpr std::uint32_t scratch_on_stack = 1024;
 
         static constexpr int max_bins = 64;
         // Below this many primitives one set of bins is used (resetting and merging a second
@@ -265,20 +312,26 @@ private:
                 }
             }
             // Inlined by force: GCC kept it a call, and the box then went through the stack.
-            [[gnu::always_inline]] void add(const BuildBox& box, const std::array<int, 4>& bin) {
+            // Without MarkOccupied, `occupied` is left for merge to find from the counts: in a
+            // large node that is a few dozen tests per node instead of three per primitive.
+            template <bool MarkOccupied = true>
+            [[gnu::always_inline]] void add(const BuildBox& box, const Bins& bin) {
                 for (int axis = 0; axis < 3; ++axis) {
                     bounds[axis][bin[axis]].extend(box);
                     ++counts[axis][bin[axis]];
-                    occupied[axis] |= std::uint64_t(1) << bin[axis];
+                    if constexpr (MarkOccupied) occupied[axis] |= std::uint64_t(1) << bin[axis];
                 }
             }
+            // Adds other's bins to these, and marks the bins that hold a primitive.
             void merge(const BinSet& other, int bin_count) {
                 for (int axis = 0; axis < 3; ++axis) {
+                    std::uint64_t mask = 0;
                     for (int b = 0; b < bin_count; ++b) {
                         bounds[axis][b].extend(other.bounds[axis][b]);
                         counts[axis][b] += other.counts[axis][b];
+                        mask |= std::uint64_t(counts[axis][b] != 0) << b;
                     }
-                    occupied[axis] |= other.occupied[axis];
+                    occupied[axis] = mask;
                 }
             }
         };
@@ -296,7 +349,7 @@ private:
             // Leave room on the traversal stack: past max_depth - 1, stop splitting.
             if (count <= 1 || depth >= max_depth - 2) return make_leaf(node, begin, end);
             if (options.leaf_at_max_size && count <= options.max_leaf_size) return make_leaf(node, begin, end);
-            const BuildBox* const range = boxes.data() + begin;
+            const BuildBox* const range = boxes + begin;
 
             const int bin_count = std::min(options.bin_count, max_bins);
             std::array<bool, 3> splittable{};
@@ -324,10 +377,8 @@ private:
                 Lanes centroid, position;
                 box.centroid(centroid);
                 bin_positions(centroid, position);
-                std::array<int, 4> bin;
-                for (int k = 0; k < 4; ++k) bin[k] = int(position[k]);
-                for (int k = 0; k < 4; ++k) bin[k] = bin[k] < bin_count - 1 ? bin[k] : bin_count - 1;
-                for (int k = 0; k < 4; ++k) bin[k] = bin[k] > 0 ? bin[k] : 0;
+                Bins bin;
+                bins_at(position, bin_count - 1, bin);
                 return bin;
             };
 
@@ -342,10 +393,13 @@ private:
                 odd_bins.reset(bin_count);
                 std::uint32_t i = 0;
                 for (; i + 1 < count; i += 2) {
-                    bins.add(range[i], bins_of(range[i]));
-                    odd_bins.add(range[i + 1], bins_of(range[i + 1]));
+                    // As in the partition: the largest nodes stream their boxes from memory,
+                    // and the box loads were this loop's hottest instructions.
+                    simd::prefetch(range[std::min(i + 16, count - 1)]);
+                    bins.add<false>(range[i], bins_of(range[i]));
+                    odd_bins.add<false>(range[i + 1], bins_of(range[i + 1]));
                 }
-                if (i < count) bins.add(range[i], bins_of(range[i]));
+                if (i < count) bins.add<false>(range[i], bins_of(range[i]));
                 bins.merge(odd_bins, bin_count);
             } else {
                 for (std::uint32_t i = 0; i < count; ++i) bins.add(range[i], bins_of(range[i]));
@@ -413,17 +467,25 @@ private:
                 if (count <= options.max_leaf_size && leaf_cost <= split_cost) return make_leaf(node, begin, end);
                 // The children's centroid bounds, gathered lane by lane as the partition sees
                 // each box (the same minima and maxima Aabb::extend would find), indexed by
-                // side rather than chosen by a branch the data would mispredict.
-                std::array<BuildBox, 2> centroid_lanes{BuildBox::empty(), BuildBox::empty()};  // right, left
-                const auto goes_left = [&](const BuildBox& box) __attribute__((always_inline)) {
+                // side rather than chosen by a branch the data would mispredict. Even and odd
+                // primitives keep separate bounds, merged afterwards, as the bins do: with one
+                // pair, a run of primitives on one side waited for each other's store (the
+                // loop's hottest instruction on the dragon). The lanes that matter take the same
+                // values in either order; only the sign of a zero bound may differ, and
+                // (c - low) * scale bins a centroid the same for +0 and -0.
+                std::array<BuildBox, 4> centroid_lanes;  // [2 * odd + left]
+                centroid_lanes.fill(BuildBox::empty());
+                const auto goes_left = [&](const BuildBox& box, std::uint32_t odd) __attribute__((always_inline)) {
                     Lanes centroid, position;
                     box.centroid(centroid);
                     bin_positions(centroid, position);
                     const bool left = std::min(bin_count - 1, int(position[best_axis])) < best_split;
-                    centroid_lanes[left].extend(centroid);
+                    centroid_lanes[2 * odd + left].extend(centroid);
                     return left;
                 };
                 middle = begin + partition(begin, end, goes_left);
+                centroid_lanes[0].extend(centroid_lanes[2]);
+                centroid_lanes[1].extend(centroid_lanes[3]);
                 left_centroids = centroid_lanes[1].aabb();
                 right_centroids = centroid_lanes[0].aabb();
             }
@@ -443,7 +505,8 @@ private:
         }
 
         // Moves the primitives of [begin, end) for which goes_left holds to the front, boxes and
-        // indices together, and returns how many there are; goes_left sees each primitive once.
+        // indices together, and returns how many there are; goes_left(box, odd) sees each primitive
+        // once, odd telling the parity of its place (for the caller's two sets of bounds).
         // The swaps are those of libstdc++'s std::partition, which this builder used before, so
         // the primitive order is unchanged. Hoare's scheme from both ends swaps the k-th
         // primitive from the front that goes right with the k-th from the back that goes left,
@@ -453,25 +516,26 @@ private:
         template <class GoesLeft>
         std::uint32_t partition(std::uint32_t begin, std::uint32_t end, const GoesLeft& goes_left) {
             const std::uint32_t count = end - begin;
-            constexpr std::uint32_t on_stack = 1024;
-            std::array<std::uint8_t, on_stack> stack_sides;
-            std::array<std::uint32_t, on_stack + 1> stack_moves;
-            std::vector<std::uint8_t> heap_sides;
-            std::vector<std::uint32_t> heap_moves;
+            // moves takes at most count slots: the front pass writes slot misplaced <= i below
+            // left_count, the back pass slots misplaced + found, where misplaced (right-goers
+            // among the first left_count) <= left_count and found < count - left_count.
+            std::array<std::uint8_t, scratch_on_stack> stack_sides;
+            std::array<std::uint32_t, scratch_on_stack> stack_moves;
             std::uint8_t* sides = stack_sides.data();
             std::uint32_t* moves = stack_moves.data();
-            if (count > on_stack) {
-                heap_sides.resize(count);
-                heap_moves.resize(std::size_t(count) + 1);
-                sides = heap_sides.data();
-                moves = heap_moves.data();
+            if (count > scratch_on_stack) {
+                sides = shared_sides + begin;
+                moves = shared_moves + begin;
             }
+            // In a local: a store to sides (bytes, which may alias anything) made the compiler
+            // reload the member before every box.
+            BuildBox* const range = boxes + begin;
             std::uint32_t left_count = 0;
             for (std::uint32_t i = 0; i < count; ++i) {
                 // Large nodes stream their boxes from memory, and this loop's chain of side-indexed
                 // updates leaves the hardware prefetcher behind: ask half a kilobyte ahead.
-                simd::prefetch(boxes[begin + std::min(i + 16, count - 1)]);
-                const bool left = goes_left(boxes[begin + i]);
+                simd::prefetch(range[std::min(i + 16, count - 1)]);
+                const bool left = goes_left(range[i], i & 1u);
                 sides[i] = left;
                 left_count += left;
             }
@@ -489,7 +553,7 @@ private:
                 found += sides[i];
             }
             for (std::uint32_t k = 0; k < misplaced; ++k) {
-                std::swap(boxes[begin + moves[k]], boxes[begin + from_back[k]]);
+                std::swap(range[moves[k]], range[from_back[k]]);
                 std::swap(indices[begin + moves[k]], indices[begin + from_back[k]]);
             }
             return left_count;

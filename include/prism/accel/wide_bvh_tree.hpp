@@ -17,6 +17,7 @@
 #pragma once
 
 #include <prism/accel/bvh_tree.hpp>
+#include <prism/memory/huge_page_allocator.hpp>
 #include <prism/simd/pack.hpp>
 #include <prism/simd/prefetch.hpp>
 
@@ -27,6 +28,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 namespace prism {
@@ -59,17 +61,24 @@ public:
     // asks for 1: an instance costs a transform and a whole BVH, far more
     // than a box test, so each gets a box of its own.
     static WideBvhTree build(std::span<const Aabb<Real>> boxes, BvhBuildOptions options = {.max_leaf_size = N}) {
+        return build(static_cast<std::uint32_t>(boxes.size()), [boxes](std::uint32_t i) { return boxes[i]; }, options);
+    }
+
+    // The same from `box_of(i)`, the box of primitive i (BvhTree::build's second form).
+    template <class BoxOf>
+        requires std::is_invocable_r_v<Aabb<Real>, const BoxOf&, std::uint32_t>
+    static WideBvhTree build(std::uint32_t count, const BoxOf& box_of, BvhBuildOptions options = {.max_leaf_size = N}) {
         options.max_leaf_size = std::clamp<std::uint32_t>(options.max_leaf_size, 1, N);
         options.leaf_at_max_size = true;  // the collapse would make such a subtree one leaf
-        const BvhTree<Real> binary = BvhTree<Real>::build(boxes, options);
+        const BvhTree<Real> binary = BvhTree<Real>::build(count, box_of, options);
         WideBvhTree tree;
-        if (boxes.empty()) return tree;
+        if (count == 0) return tree;
         tree.bounds_ = binary.bounds();
         Collapser collapser{binary, tree, options.max_leaf_size, {}, {}, {}, {}};
         collapser.ranges.resize(binary.nodes().size());
         collapser.measure(0);
         collapser.cost.resize(binary.nodes().size() * N);
-        collapser.split.resize(binary.nodes().size() * N);
+        collapser.split.resize(binary.nodes().size() * N, 0);  // a leaf's entries are read, not written
         collapser.as_leaf.resize(binary.nodes().size());
         // A mesh's leaf may take two packets where that is cheaper than another child: the
         // bottom of the tree then has fewer nodes. A top level keeps its own limit.
@@ -325,15 +334,18 @@ private:
         struct Range {
             std::uint32_t begin, end;
         };
-        std::vector<Range> ranges;  // each binary node's contiguous range of primitive_indices
+        // Written whole before they are read: not cleared, and in huge pages (accel/bvh_tree.hpp).
+        template <class T>
+        using Array = std::vector<T, HugePageAllocator<T>>;
+        Array<Range> ranges;  // each binary node's contiguous range of primitive_indices
         // The cheapest way to hold each binary subtree in k child slots, k = 1..N, in the surface
         // area heuristic's units: a node test costs its box's half area, a leaf its box's half
         // area per packet (a packet test and a node test take about as long: both are one SIMD
         // pass over N lanes, and costing packets at 0.5 or 2 times a node made the same trees
         // within 1% of nodes).
-        std::vector<double> cost;           // [node * N + k - 1]
-        std::vector<std::uint8_t> split;    // slots given to the left child; 0: one slot holds it all
-        std::vector<std::uint8_t> as_leaf;  // the one-slot form is a leaf
+        Array<double> cost;           // [node * N + k - 1]
+        Array<std::uint8_t> split;    // slots given to the left child; 0: one slot holds it all
+        Array<std::uint8_t> as_leaf;  // the one-slot form is a leaf
         std::uint32_t leaf_limit = 0;
 
         Range measure(std::uint32_t i) {

@@ -12,6 +12,7 @@
 #include <prism/math/floating_point.hpp>
 #include <prism/scene/scene.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -38,8 +39,8 @@ public:
         const scene::Mesh* const parts[] = {&mesh};
         build_index(parts);
         const auto& order = index_.primitive_indices();
-        faces_.resize(order.size());
-        for (std::size_t slot = 0; slot < order.size(); ++slot) faces_[slot] = mesh.triangles[order[slot]];
+        faces_.reserve(order.size());
+        for (const std::uint32_t i : order) faces_.push_back(mesh.triangles[i]);
         keep_shading_data(mesh);
     }
 
@@ -49,11 +50,12 @@ public:
     struct ShadingOnly {};
     TriangleMesh(const scene::Mesh& mesh, ShadingOnly)
         : smooth_(mesh.shading == scene::ShadingMode::smooth), triangle_count_(mesh.triangles.size()) {
-        triangles_.resize(mesh.triangles.size());
+        triangles_.reserve(mesh.triangles.size());
         faces_ = mesh.triangles;
-        for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
-            for (int k = 0; k < 3; ++k) triangles_[i][k] = Vec3<Storage>(mesh.positions[mesh.triangles[i][k]]);
-            bounds_.extend(triangle_box(mesh, mesh.triangles[i]));
+        for (const auto& face : mesh.triangles) {
+            triangles_.push_back({Vec3<Storage>(mesh.positions[face[0]]), Vec3<Storage>(mesh.positions[face[1]]),
+                                  Vec3<Storage>(mesh.positions[face[2]])});
+            bounds_.extend(triangle_box(mesh, face));
         }
         keep_shading_data(mesh);
     }
@@ -230,30 +232,45 @@ private:
     // The index over the parts' triangles (their boxes widened where Storage is wider than
     // Real), and the triangles copied into its slots, with their packets.
     void build_index(std::span<const scene::Mesh* const> parts) {
-        std::vector<Aabb<Real>> boxes;
-        boxes.reserve(triangle_count_);
-        std::vector<const std::array<std::uint32_t, 3>*> faces;
-        std::vector<const scene::Mesh*> owners;
-        faces.reserve(triangle_count_);
-        owners.reserve(triangle_count_);
-        for (const scene::Mesh* part : parts) {
-            for (const auto& face : part->triangles) {
-                const Aabb<Real> box = triangle_box(*part, face);
-                bounds_.extend(box);
-                boxes.push_back(box);
-                faces.push_back(&face);
-                owners.push_back(part);
+        // Triangle i of the parts laid end to end: part p holds [first[p], first[p + 1]). Found
+        // by search rather than kept per triangle (two pointer arrays of the triangle count).
+        std::vector<std::uint32_t> first{0};
+        for (const scene::Mesh* part : parts) first.push_back(first.back() + std::uint32_t(part->triangles.size()));
+        const auto part_of = [&](std::uint32_t i) {
+            return std::size_t(std::upper_bound(first.begin() + 1, first.end(), i) - (first.begin() + 1));
+        };
+        const auto face_of = [&](std::uint32_t i, std::size_t part) -> const std::array<std::uint32_t, 3>& {
+            return parts[part]->triangles[i - first[part]];
+        };
+        const auto box_of = [&](std::uint32_t i) {
+            const std::size_t part = part_of(i);
+            return triangle_box(*parts[part], face_of(i, part));
+        };
+        if constexpr (requires { Index::build(std::uint32_t(0), box_of); }) {
+            // The index takes the boxes as they are made; its root box is the one the loop
+            // below would find (the same boxes extended in the same order).
+            index_ = Index::build(std::uint32_t(triangle_count_), box_of);
+            bounds_ = index_.bounds();
+        } else {
+            std::vector<Aabb<Real>> boxes;
+            boxes.reserve(triangle_count_);
+            for (std::uint32_t i = 0; i < std::uint32_t(triangle_count_); ++i) {
+                boxes.push_back(box_of(i));
+                bounds_.extend(boxes.back());
             }
+            index_ = Index::build(boxes);
         }
-        index_ = Index::build(boxes);
         // An index may repeat primitives to pad its leaves (the wide BVH): slots then outnumber
-        // triangles, and the repeats are copies that no leaf callback reports.
+        // triangles, and the repeats are copies that no leaf callback reports. Appended, not
+        // resized and assigned: resize would clear the whole array first.
         const auto& order = index_.primitive_indices();
-        triangles_.resize(order.size());
-        for (std::size_t slot = 0; slot < order.size(); ++slot) {
-            const auto& face = *faces[order[slot]];
-            const scene::Mesh& owner = *owners[order[slot]];
-            for (int k = 0; k < 3; ++k) triangles_[slot][k] = Vec3<Storage>(owner.positions[face[k]]);
+        triangles_.reserve(order.size());
+        for (const std::uint32_t i : order) {
+            const std::size_t part = part_of(i);
+            const auto& face = face_of(i, part);
+            const auto& positions = parts[part]->positions;
+            triangles_.push_back({Vec3<Storage>(positions[face[0]]), Vec3<Storage>(positions[face[1]]),
+                                  Vec3<Storage>(positions[face[2]])});
         }
         if constexpr (packed) packets_ = Packets(triangles_);
     }
