@@ -70,7 +70,7 @@ public:
         // The builder's arrays are written whole before they are read, so they are not cleared,
         // and come in huge pages: fresh memory's page faults in 4 kB pages were a tenth of the
         // dragon's build.
-        Array<BuildBox> build_boxes(count);
+        HugePageVector<BuildBox> build_boxes(count);
         Aabb<Real> root_bounds, centroid_bounds;
         for (std::uint32_t i = 0; i < count; ++i) {
             const Aabb<Real> box = box_of(i);
@@ -94,8 +94,8 @@ public:
         // The large nodes' partition scratch, one byte and one index per primitive, made once:
         // a node uses the slots of its own range, which no node being partitioned at the same
         // time shares (a parallel subtree starts after its parent's partition has ended).
-        Array<std::uint8_t> sides(count > Builder::scratch_on_stack ? count : 0);
-        Array<std::uint32_t> moves(sides.size());
+        HugePageVector<std::uint8_t> sides(count > Builder::scratch_on_stack ? count : 0);
+        HugePageVector<std::uint32_t> moves(sides.size());
         Builder builder{build_boxes.data(), tree.primitive_indices_, nodes, options, {1}, sides.data(), moves.data()};
         builder.build(0, 0, count, centroid_bounds, 0);
         tree.nodes_.assign(nodes, nodes + builder.node_count.load());
@@ -278,9 +278,6 @@ private:
             return made;
         }
     };
-
-    template <class T>
-    using Array = std::vector<T, HugePageAllocator<T>>;
 
     struct Builder {
         BuildBox* boxes;  // in the order of indices

@@ -335,17 +335,15 @@ private:
             std::uint32_t begin, end;
         };
         // Written whole before they are read: not cleared, and in huge pages (accel/bvh_tree.hpp).
-        template <class T>
-        using Array = std::vector<T, HugePageAllocator<T>>;
-        Array<Range> ranges;  // each binary node's contiguous range of primitive_indices
+        HugePageVector<Range> ranges;  // each binary node's contiguous range of primitive_indices
         // The cheapest way to hold each binary subtree in k child slots, k = 1..N, in the surface
         // area heuristic's units: a node test costs its box's half area, a leaf its box's half
         // area per packet (a packet test and a node test take about as long: both are one SIMD
         // pass over N lanes, and costing packets at 0.5 or 2 times a node made the same trees
         // within 1% of nodes).
-        Array<double> cost;           // [node * N + k - 1]
-        Array<std::uint8_t> split;    // slots given to the left child; 0: one slot holds it all
-        Array<std::uint8_t> as_leaf;  // the one-slot form is a leaf
+        HugePageVector<double> cost;           // [node * N + k - 1]
+        HugePageVector<std::uint8_t> split;    // slots given to the left child; 0: one slot holds it all
+        HugePageVector<std::uint8_t> as_leaf;  // the one-slot form is a leaf
         std::uint32_t leaf_limit = 0;
 
         Range measure(std::uint32_t i) {

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <new>
 #include <utility>
+#include <vector>
 
 #ifdef __linux__
 #include <sys/mman.h>
@@ -60,5 +61,9 @@ struct HugePageAllocator {
     template <class U>
     bool operator==(const HugePageAllocator<U>&) const noexcept { return true; }
 };
+
+// A vector of such an array: its elements are not cleared on resize, only written by its owner.
+template <class T>
+using HugePageVector = std::vector<T, HugePageAllocator<T>>;
 
 }  // namespace prism
