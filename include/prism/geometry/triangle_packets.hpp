@@ -6,9 +6,6 @@
 // shrinking t_max, exactly as the scalar leaf loop does. The packed test is therefore as
 // watertight as the scalar one and picks the same triangle on every tie.
 // DoubleRefine runs the same test on packets of double vertices under float traversal.
-// Packets of double vertices hold them as floats where every vertex of the mesh is exactly a
-// float (PLY files store float32): widened on the load, they are the same doubles, so the test
-// and its every bit are unchanged while a packet's bytes halve (the double test waits on them).
 #pragma once
 
 #include <prism/geometry/double_refine.hpp>
@@ -56,35 +53,23 @@ public:
 
     TrianglePackets() = default;
 
-    // How double vertices are stored: as floats where all of them are exactly floats, or
-    // always as doubles (for tests that compare the two).
-    enum class VertexStorage { narrowest_exact, as_declared };
-
     // `triangles` in slot order, a multiple of N of them (the wide BVH pads its leaves).
-    explicit TrianglePackets(const std::vector<std::array<Vec3<Storage>, 3>>& triangles,
-                             VertexStorage storage = VertexStorage::narrowest_exact) {
+    explicit TrianglePackets(const std::vector<std::array<Vec3<Storage>, 3>>& triangles) {
+        packets_.resize(triangles.size() / N);
         normals_.resize(triangles.size());
         for (std::size_t slot = 0; slot < triangles.size(); ++slot) {
+            Packet& packet = packets_[slot / N];
             const auto& p = triangles[slot];
+            for (int vertex = 0; vertex < 3; ++vertex)
+                for (int axis = 0; axis < 3; ++axis) packet.vertices[vertex][axis][slot % N] = p[vertex][axis];
             // The back-face test's normal, rounded as TriangleMesh's scalar loop rounds it.
             normals_[slot] = Vec3<Real>(glm::cross(p[1] - p[0], p[2] - p[0]));
         }
-        if constexpr (may_narrow) {
-            if (storage == VertexStorage::narrowest_exact && all_exactly_float(triangles)) {
-                fill(narrow_packets_, triangles);
-                return;
-            }
-        }
-        fill(packets_, triangles);
     }
 
     std::size_t memory_bytes() const {
-        return packets_.capacity() * sizeof(Packet) + narrow_packets_.capacity() * sizeof(NarrowPacket) +
-               normals_.capacity() * sizeof(Vec3<Real>);
+        return packets_.capacity() * sizeof(Packet) + normals_.capacity() * sizeof(Vec3<Real>);
     }
-
-    // Whether the vertices are held as floats (double storage whose every vertex is a float).
-    bool float_vertices() const { return !narrow_packets_.empty(); }
 
     // Closest hit among slots [first, first + count) (first a multiple of N); lowers t_limit.
     // Forced inline into the traversal's leaf callback, as is `test`: GCC had kept it a function
@@ -95,7 +80,7 @@ public:
         bool found = false;
         for (std::uint32_t base = first; base < first + count; base += N) {
             alignas(64) Storage t[N], b1[N], b2[N];
-            std::uint32_t lanes = test_packet(base / N, ray, Storage(t_min), Storage(t_limit), t, b1, b2);
+            std::uint32_t lanes = test(packets_[base / N], ray, Storage(t_min), Storage(t_limit), t, b1, b2);
             lanes &= lane_mask(first + count - base);
             while (lanes != 0) {
                 const int lane = std::countr_zero(lanes);
@@ -118,21 +103,13 @@ public:
     }
 
     // Requests the packet that holds slot `first` (a leaf's first slot) from memory.
-    void prefetch(std::uint32_t first) const {
-        if constexpr (may_narrow) {
-            if (!narrow_packets_.empty()) {
-                simd::prefetch(narrow_packets_[first / N]);
-                return;
-            }
-        }
-        simd::prefetch(packets_[first / N]);
-    }
+    void prefetch(std::uint32_t first) const { simd::prefetch(packets_[first / N]); }
 
     // Whether any of slots [first, first + count) is hit in (t_min, t_limit).
     [[gnu::always_inline]] bool occluded(const PackedRay& ray, std::uint32_t first, std::uint32_t count, Real t_min, Real t_limit) const {
         for (std::uint32_t base = first; base < first + count; base += N) {
             alignas(64) Storage t[N], b1[N], b2[N];
-            std::uint32_t lanes = test_packet(base / N, ray, Storage(t_min), Storage(t_limit), t, b1, b2);
+            std::uint32_t lanes = test(packets_[base / N], ray, Storage(t_min), Storage(t_limit), t, b1, b2);
             lanes &= lane_mask(first + count - base);
             while (lanes != 0) {
                 const int lane = std::countr_zero(lanes);
@@ -145,41 +122,9 @@ public:
     }
 
 private:
-    template <class Vertex>
-    struct alignas(64) PacketOf {
-        Vertex vertices[3][3][N];  // [vertex][axis][lane]
+    struct alignas(64) Packet {
+        Storage vertices[3][3][N];  // [vertex][axis][lane]
     };
-    using Packet = PacketOf<Storage>;
-    using NarrowPacket = PacketOf<float>;  // for double storage only; float's own packets are Packet
-    static constexpr bool may_narrow = std::is_same_v<Storage, double>;
-
-    static bool all_exactly_float(const std::vector<std::array<Vec3<Storage>, 3>>& triangles) {
-        for (const auto& p : triangles)
-            for (int vertex = 0; vertex < 3; ++vertex)
-                for (int axis = 0; axis < 3; ++axis)
-                    // False for NaN and for doubles beyond float's range (they round to infinity).
-                    if (!(double(float(p[vertex][axis])) == p[vertex][axis])) return false;
-        return true;
-    }
-
-    template <class Vertex>
-    static void fill(std::vector<PacketOf<Vertex>>& packets, const std::vector<std::array<Vec3<Storage>, 3>>& triangles) {
-        packets.resize(triangles.size() / N);
-        for (std::size_t slot = 0; slot < triangles.size(); ++slot)
-            for (int vertex = 0; vertex < 3; ++vertex)
-                for (int axis = 0; axis < 3; ++axis)
-                    packets[slot / N].vertices[vertex][axis][slot % N] = Vertex(triangles[slot][vertex][axis]);
-    }
-
-    // The test on the packet of index `packet`, from whichever storage this mesh keeps. The
-    // branch goes the same way for every leaf of a mesh.
-    [[gnu::always_inline]] std::uint32_t test_packet(std::size_t packet, const PackedRay& ray, Storage t_min, Storage t_max,
-                                                     Storage* t_out, Storage* b1_out, Storage* b2_out) const {
-        if constexpr (may_narrow) {
-            if (!narrow_packets_.empty()) return test(narrow_packets_[packet], ray, t_min, t_max, t_out, b1_out, b2_out);
-        }
-        return test(packets_[packet], ray, t_min, t_max, t_out, b1_out, b2_out);
-    }
 
     static const Watertight::Prepared<Storage>& watertight_ray(const Prepared& prepared) {
         if constexpr (std::is_same_v<Intersector, DoubleRefine>)
@@ -194,14 +139,10 @@ private:
 
     // Watertight::intersect on every lane: the lanes hit in (t_min, t_max], with their t and
     // barycentrics stored. Same operations, same order, so the same bits as the scalar test.
-    template <class Vertex>
-    [[gnu::always_inline]] static std::uint32_t test(const PacketOf<Vertex>& packet, const PackedRay& ray, Storage t_min,
-                                                     Storage t_max, Storage* t_out, Storage* b1_out, Storage* b2_out) {
+    [[gnu::always_inline]] static std::uint32_t test(const Packet& packet, const PackedRay& ray, Storage t_min, Storage t_max,
+                              Storage* t_out, Storage* b1_out, Storage* b2_out) {
         const auto relative = [&](int vertex, int axis) {
-            if constexpr (std::is_same_v<Vertex, Storage>)
-                return Pack::load(packet.vertices[vertex][axis]) - ray.origin[axis];
-            else
-                return Pack::load_widened(packet.vertices[vertex][axis]) - ray.origin[axis];
+            return Pack::load(packet.vertices[vertex][axis]) - ray.origin[axis];
         };
         const Pack a_z = relative(0, ray.kz), b_z = relative(1, ray.kz), c_z = relative(2, ray.kz);
         const Pack ax = relative(0, ray.kx) - ray.sx * a_z;
@@ -257,8 +198,7 @@ private:
         return lanes;
     }
 
-    std::vector<Packet> packets_;              // empty where narrow_packets_ holds the vertices
-    std::vector<NarrowPacket> narrow_packets_;  // double storage whose vertices are all floats
+    std::vector<Packet> packets_;
     std::vector<Vec3<Real>> normals_;  // per slot, read only when culling back faces
 };
 

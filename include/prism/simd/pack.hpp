@@ -12,7 +12,6 @@
 
 #include <array>
 #include <cstdint>
-#include <type_traits>
 
 #if !defined(PRISM_SIMD_SCALAR) && defined(__GLIBCXX__) && __has_include(<experimental/simd>)
 #include <experimental/simd>
@@ -53,23 +52,6 @@ struct Pack {
 
     PRISM_SIMD_INLINE static Pack broadcast(T value) { return {Native(value)}; }
     PRISM_SIMD_INLINE static Pack load(const T* values) { return {Native(values, stdx::element_aligned)}; }
-    // N floats widened to double on the load (one vcvtps2pd on x86): exact, every float is a double.
-    // GCC 12's _mm512_cvtps_pd passes an undefined register as its unused merge source, which
-    // -Wmaybe-uninitialized reports once inlined here: a false positive, silenced for this load.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
-    PRISM_SIMD_INLINE static Pack load_widened(const float* values)
-        requires std::is_same_v<T, double>
-    {
-        using Narrow = stdx::simd<float, stdx::simd_abi::deduce_t<float, N>>;
-        return {stdx::static_simd_cast<Native>(Narrow(values, stdx::element_aligned))};
-    }
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic pop
-#endif
     PRISM_SIMD_INLINE void store(T* values) const { native.copy_to(values, stdx::element_aligned); }
 
     PRISM_SIMD_INLINE friend Pack operator+(Pack a, Pack b) { return {a.native + b.native}; }
@@ -127,13 +109,6 @@ struct Pack {
     PRISM_SIMD_INLINE static Pack load(const T* values) {
         Pack result;
         for (int i = 0; i < N; ++i) result.lanes[i] = values[i];
-        return result;
-    }
-    PRISM_SIMD_INLINE static Pack load_widened(const float* values)
-        requires std::is_same_v<T, double>
-    {
-        Pack result;
-        for (int i = 0; i < N; ++i) result.lanes[i] = double(values[i]);
         return result;
     }
     PRISM_SIMD_INLINE void store(T* values) const {
