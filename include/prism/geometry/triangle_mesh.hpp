@@ -97,6 +97,14 @@ public:
         explicit TriangleRay(const Ray<Real>& ray) : prepared(ray), packed_ray(prepared) {}
     };
 
+    // Whether a ray may reach a leaf of the index, decided by the index's own first node test
+    // (WideBvhTree::enters); only for an index that has one.
+    [[gnu::always_inline]] bool enters(const TraversalRay& ray, Real t_min, Real t_max) const
+        requires requires(const Index& index) { index.enters(ray, t_min, t_max); }
+    {
+        return index_.enters(ray, t_min, t_max);
+    }
+
     // Closest hit along `ray` (object space) below t_max; lowers t_max and fills t, primitive,
     // barycentrics. Culling skips triangles whose winding faces away from the ray.
     template <bool CullBackfaces>
