@@ -76,7 +76,12 @@ public:
 
     // The triangle in `slot`, numbered as the meshes it was built from list them (part after
     // part for several meshes).
-    std::uint32_t source_triangle(std::uint32_t slot) const { return index_.primitive_indices()[slot]; }
+    std::uint32_t source_triangle(std::uint32_t slot) const {
+        if constexpr (packed) {
+            if constexpr (Packets::keeps_sources) return packets_.source(slot);
+        }
+        return index_.primitive_indices()[slot];
+    }
 
     Aabb<Real> bounds() const { return bounds_; }
     std::size_t triangle_count() const { return triangle_count_; }
@@ -280,7 +285,7 @@ private:
             triangles_.push_back({Vec3<Storage>(positions[face[0]]), Vec3<Storage>(positions[face[1]]),
                                   Vec3<Storage>(positions[face[2]])});
         }
-        if constexpr (packed) packets_ = Packets(triangles_);
+        if constexpr (packed) packets_ = Packets(triangles_, order);
     }
 
     static Aabb<Real> triangle_box(const scene::Mesh& mesh, const std::array<std::uint32_t, 3>& face) {
