@@ -1199,6 +1199,17 @@ TEST_CASE_TEMPLATE("Indices: a ray prepared once traverses exactly as the ray it
 
 namespace {
 
+// The boxes of a perturbed icosphere's triangles (three subdivisions) and 2000 test rays
+// around it: what the traversal-only checks below run on.
+template <class Real>
+std::pair<std::vector<prism::Aabb<Real>>, std::vector<prism::Ray<Real>>> sphere_boxes_and_rays(std::uint32_t mesh_seed,
+                                                                                              std::uint32_t ray_seed) {
+    std::vector<glm::dvec3> positions;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    perturbed_sphere(3, mesh_seed, positions, triangles);
+    return {triangle_boxes<Real>(positions, triangles), test_rays<Real>(bounds_of(positions), positions, 2000, ray_seed)};
+}
+
 // The touch callback (a wide BVH prefetching the leaves it pushes) is a hint: traversal with it
 // visits the same leaves in the same order with the same t_max, and it only ever names leaves.
 template <class Real, int N>
@@ -1233,11 +1244,7 @@ void check_touched_traversal(const std::vector<prism::Aabb<Real>>& boxes, const 
 }  // namespace
 
 TEST_CASE_TEMPLATE("Wide BVH: prefetching pushed leaves changes nothing of the traversal", Real, float, double) {
-    std::vector<glm::dvec3> positions;
-    std::vector<std::array<std::uint32_t, 3>> triangles;
-    perturbed_sphere(3, 19, positions, triangles);
-    const auto boxes = triangle_boxes<Real>(positions, triangles);
-    const auto rays = test_rays<Real>(bounds_of(positions), positions, 2000, 43);
+    const auto [boxes, rays] = sphere_boxes_and_rays<Real>(19, 43);
     check_touched_traversal<Real, 4>(boxes, rays);
     check_touched_traversal<Real, 8>(boxes, rays);
 }
@@ -1276,11 +1283,7 @@ void check_root_test(const std::vector<prism::Aabb<Real>>& boxes, const std::vec
 }  // namespace
 
 TEST_CASE_TEMPLATE("Wide BVH: a ray the root's test turns away visits no leaf", Real, float, double) {
-    std::vector<glm::dvec3> positions;
-    std::vector<std::array<std::uint32_t, 3>> triangles;
-    perturbed_sphere(3, 29, positions, triangles);
-    const auto boxes = triangle_boxes<Real>(positions, triangles);
-    const auto rays = test_rays<Real>(bounds_of(positions), positions, 2000, 47);
+    const auto [boxes, rays] = sphere_boxes_and_rays<Real>(29, 47);
     check_root_test<Real, 4>(boxes, rays);
     check_root_test<Real, 8>(boxes, rays);
     CHECK(!prism::WideBvhTree<Real, 8>().enters(typename prism::WideBvhTree<Real, 8>::TraversalRay(rays[0]), Real(0),
