@@ -1199,6 +1199,17 @@ TEST_CASE_TEMPLATE("Indices: a ray prepared once traverses exactly as the ray it
 
 namespace {
 
+// The boxes of a perturbed icosphere's triangles (three subdivisions) and 2000 test rays
+// around it: what the traversal-only checks below run on.
+template <class Real>
+std::pair<std::vector<prism::Aabb<Real>>, std::vector<prism::Ray<Real>>> sphere_boxes_and_rays(std::uint32_t mesh_seed,
+                                                                                              std::uint32_t ray_seed) {
+    std::vector<glm::dvec3> positions;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    perturbed_sphere(3, mesh_seed, positions, triangles);
+    return {triangle_boxes<Real>(positions, triangles), test_rays<Real>(bounds_of(positions), positions, 2000, ray_seed)};
+}
+
 // The touch callback (a wide BVH prefetching the leaves it pushes) is a hint: traversal with it
 // visits the same leaves in the same order with the same t_max, and it only ever names leaves.
 template <class Real, int N>
@@ -1233,13 +1244,50 @@ void check_touched_traversal(const std::vector<prism::Aabb<Real>>& boxes, const 
 }  // namespace
 
 TEST_CASE_TEMPLATE("Wide BVH: prefetching pushed leaves changes nothing of the traversal", Real, float, double) {
-    std::vector<glm::dvec3> positions;
-    std::vector<std::array<std::uint32_t, 3>> triangles;
-    perturbed_sphere(3, 19, positions, triangles);
-    const auto boxes = triangle_boxes<Real>(positions, triangles);
-    const auto rays = test_rays<Real>(bounds_of(positions), positions, 2000, 43);
+    const auto [boxes, rays] = sphere_boxes_and_rays<Real>(19, 43);
     check_touched_traversal<Real, 4>(boxes, rays);
     check_touched_traversal<Real, 8>(boxes, rays);
+}
+
+namespace {
+
+// WideBvhTree::enters, the root's test that SceneGeometry makes before it prepares a world-space
+// index's triangle set-up: a ray it turns away must visit no leaf, closest or any hit; and the
+// rays of the test miss the tree often enough that turning none away would fail.
+template <class Real, int N>
+void check_root_test(const std::vector<prism::Aabb<Real>>& boxes, const std::vector<prism::Ray<Real>>& rays) {
+    const auto tree = prism::WideBvhTree<Real, N>::build(boxes);
+    std::size_t turned_away = 0, visited_anyway = 0, entered_and_visited = 0;
+    for (const prism::Ray<Real>& ray : rays) {
+        const typename prism::WideBvhTree<Real, N>::TraversalRay prepared(ray);
+        LeafLog<Real> log;
+        Real t_max = ray.t_max;
+        tree.traverse_closest(prepared, ray.t_min, t_max, log.closest());
+        bool any_visit = false;
+        tree.traverse_any(prepared, ray.t_min, ray.t_max, [&](std::uint32_t, std::uint32_t, Real&) {
+            any_visit = true;
+            return false;
+        });
+        if (tree.enters(prepared, ray.t_min, ray.t_max)) {
+            entered_and_visited += !log.visits.empty();
+        } else {
+            ++turned_away;
+            visited_anyway += !log.visits.empty() || any_visit;
+        }
+    }
+    CHECK(visited_anyway == 0);
+    CHECK(turned_away > 0);
+    CHECK(entered_and_visited > 0);
+}
+
+}  // namespace
+
+TEST_CASE_TEMPLATE("Wide BVH: a ray the root's test turns away visits no leaf", Real, float, double) {
+    const auto [boxes, rays] = sphere_boxes_and_rays<Real>(29, 47);
+    check_root_test<Real, 4>(boxes, rays);
+    check_root_test<Real, 8>(boxes, rays);
+    CHECK(!prism::WideBvhTree<Real, 8>().enters(typename prism::WideBvhTree<Real, 8>::TraversalRay(rays[0]), Real(0),
+                                               prism::infinity<Real>));
 }
 
 TEST_CASE_TEMPLATE("TriangleMesh: the caller's shared ray set-up finds the hits of the mesh's own", Real, float, double) {

@@ -176,7 +176,7 @@ public:
         std::optional<RayBoxPrecomputed<Real>> box_ray;  // made once, for the first group's box
         for (const WorldMeshes& group : world_meshes_) {
             const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
-            if (!enters(index, ray, box_ray)) continue;
+            if (!enters(index, ray, traversal_ray, box_ray)) continue;
             if (!world_triangle_ray) world_triangle_ray.emplace(ray);
             const bool cull =
                 Culling == BackfaceCulling::all || (Culling == BackfaceCulling::flat_triangles && !group.smooth);
@@ -231,7 +231,7 @@ public:
         std::optional<RayBoxPrecomputed<Real>> box_ray;
         for (const WorldMeshes& group : world_meshes_) {
             const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
-            if (!enters(index, ray, box_ray)) continue;
+            if (!enters(index, ray, traversal_ray, box_ray)) continue;
             if (!world_triangle_ray) world_triangle_ray.emplace(ray);
             if (index.occluded(ray, traversal_ray, *world_triangle_ray, ray.t_max)) return true;
         }
@@ -520,9 +520,16 @@ private:
     // conservative slab test as the BVHs (Ize's widened exit): the triangle set-up is then made
     // before the index is entered (eagerly, outside the kernel's leaf loop) and only for rays
     // that may reach a leaf, as the top level's box test did for a mesh in it.
-    static bool enters(const Mesh& index, const Ray<Real>& ray, std::optional<RayBoxPrecomputed<Real>>& box_ray) {
-        if (!box_ray) box_ray.emplace(ray);
-        return intersect_box(index.bounds(), *box_ray, ray.t_min, ray.t_max, robust_far_scale<Real>) != infinity<Real>;
+    // A wide BVH tests its root's children with the traversal ray instead (WideBvhTree::enters):
+    // no division of its own, and rays between the children's boxes are stopped too.
+    static bool enters(const Mesh& index, const Ray<Real>& ray, const TraversalRay& traversal_ray,
+                       std::optional<RayBoxPrecomputed<Real>>& box_ray) {
+        if constexpr (requires { index.enters(traversal_ray, ray.t_min, ray.t_max); }) {
+            return index.enters(traversal_ray, ray.t_min, ray.t_max);
+        } else {
+            if (!box_ray) box_ray.emplace(ray);
+            return intersect_box(index.bounds(), *box_ray, ray.t_min, ray.t_max, robust_far_scale<Real>) != infinity<Real>;
+        }
     }
 
     // Whether the instance's object space is the world's at every instant: then its mesh

@@ -76,7 +76,12 @@ public:
 
     // The triangle in `slot`, numbered as the meshes it was built from list them (part after
     // part for several meshes).
-    std::uint32_t source_triangle(std::uint32_t slot) const { return index_.primitive_indices()[slot]; }
+    std::uint32_t source_triangle(std::uint32_t slot) const {
+        if constexpr (packed) {
+            if constexpr (Packets::keeps_sources) return packets_.source(slot);
+        }
+        return index_.primitive_indices()[slot];
+    }
 
     Aabb<Real> bounds() const { return bounds_; }
     std::size_t triangle_count() const { return triangle_count_; }
@@ -96,6 +101,14 @@ public:
         typename Packets::PackedRay packed_ray;
         explicit TriangleRay(const Ray<Real>& ray) : prepared(ray), packed_ray(prepared) {}
     };
+
+    // Whether a ray may reach a leaf of the index, decided by the index's own first node test
+    // (WideBvhTree::enters); only for an index that has one.
+    [[gnu::always_inline]] bool enters(const TraversalRay& ray, Real t_min, Real t_max) const
+        requires requires(const Index& index) { index.enters(ray, t_min, t_max); }
+    {
+        return index_.enters(ray, t_min, t_max);
+    }
 
     // Closest hit along `ray` (object space) below t_max; lowers t_max and fills t, primitive,
     // barycentrics. Culling skips triangles whose winding faces away from the ray.
@@ -272,7 +285,7 @@ private:
             triangles_.push_back({Vec3<Storage>(positions[face[0]]), Vec3<Storage>(positions[face[1]]),
                                   Vec3<Storage>(positions[face[2]])});
         }
-        if constexpr (packed) packets_ = Packets(triangles_);
+        if constexpr (packed) packets_ = Packets(triangles_, order);
     }
 
     static Aabb<Real> triangle_box(const scene::Mesh& mesh, const std::array<std::uint32_t, 3>& face) {

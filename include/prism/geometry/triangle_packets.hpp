@@ -53,9 +53,26 @@ public:
 
     TrianglePackets() = default;
 
-    // `triangles` in slot order, a multiple of N of them (the wide BVH pads its leaves).
-    explicit TrianglePackets(const std::vector<std::array<Vec3<Storage>, 3>>& triangles) {
+    // Whether a packet also holds its slots' source numbers (TriangleMesh::source_triangle):
+    // where its vertices leave at least that much of their last cache line unused (float: 288
+    // bytes of vertices in a 320-byte packet), so the numbers cost no memory and sit on a line
+    // the test has just read. A merged index looks its hit's number up after the traversal,
+    // and the separate array's load missed the cache: a fifth of SceneGeometry::intersect's
+    // samples on the course's diffuse rays.
+    static constexpr std::size_t vertex_bytes = 9 * N * sizeof(Storage);
+    static constexpr bool keeps_sources =
+        vertex_bytes % simd::cache_line_bytes != 0 &&
+        simd::cache_line_bytes - vertex_bytes % simd::cache_line_bytes >= N * sizeof(std::uint32_t);
+
+    // `triangles` in slot order, a multiple of N of them (the wide BVH pads its leaves), and
+    // `sources`, each slot's source number, kept where keeps_sources.
+    TrianglePackets(const std::vector<std::array<Vec3<Storage>, 3>>& triangles, const std::vector<std::uint32_t>& sources) {
         packets_.resize(triangles.size() / N);
+        if constexpr (keeps_sources) {
+            for (std::size_t slot = 0; slot < triangles.size(); ++slot) packets_[slot / N].sources[slot % N] = sources[slot];
+        } else {
+            (void)sources;
+        }
         normals_.resize(triangles.size());
         for (std::size_t slot = 0; slot < triangles.size(); ++slot) {
             Packet& packet = packets_[slot / N];
@@ -102,6 +119,13 @@ public:
         return found;
     }
 
+    // The source number of `slot`, as given to the constructor.
+    std::uint32_t source(std::uint32_t slot) const
+        requires keeps_sources
+    {
+        return packets_[slot / N].sources[slot % N];
+    }
+
     // Requests the packet that holds slot `first` (a leaf's first slot) from memory.
     void prefetch(std::uint32_t first) const { simd::prefetch(packets_[first / N]); }
 
@@ -122,9 +146,15 @@ public:
     }
 
 private:
-    struct alignas(64) Packet {
+    struct alignas(64) PacketAlone {
         Storage vertices[3][3][N];  // [vertex][axis][lane]
     };
+    struct alignas(64) PacketWithSources {
+        Storage vertices[3][3][N];
+        std::uint32_t sources[N];  // in the last line's otherwise unused bytes
+    };
+    using Packet = std::conditional_t<keeps_sources, PacketWithSources, PacketAlone>;
+    static_assert(sizeof(Packet) == sizeof(PacketAlone), "the source numbers must fit the packet's padding");
 
     static const Watertight::Prepared<Storage>& watertight_ray(const Prepared& prepared) {
         if constexpr (std::is_same_v<Intersector, DoubleRefine>)
