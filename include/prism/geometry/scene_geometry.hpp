@@ -51,7 +51,11 @@ struct PlaneShape {
     bool intersect(const Ray<Real>& ray, Real t_min, Real t_max, Real& t_hit) const {
         const Real denominator = glm::dot(ray.direction, normal);
         if (denominator == 0) return false;
-        const Real t = glm::dot(point - ray.origin, normal) / denominator;
+        const Real numerator = glm::dot(point - ray.origin, normal);
+        // Opposite signs (or a zero numerator) give a t of at most 0, which no t_min >= 0
+        // accepts: the division is left out (planes behind the ray, half of a room's walls).
+        if (t_min >= 0 && (numerator == 0 || std::signbit(numerator) != std::signbit(denominator))) return false;
+        const Real t = numerator / denominator;
         if (!(t > t_min && t <= t_max)) return false;
         t_hit = t;
         return true;

@@ -6,6 +6,9 @@
 #include <prism/math/vector.hpp>
 #include <prism/scene/scene.hpp>
 
+#include <cmath>
+#include <limits>
+
 namespace prism {
 
 template <Scalar Real>
@@ -20,13 +23,31 @@ struct Material {
     Real roughness = 0;  // perturbs reflected and refracted directions (render/whitted_integrator.hpp)
     Brdf<Real> brdf;     // the course's original Blinn-Phong unless the material names a BRDF
     bool brdf_given = false;
+    // Where the Blinn-Phong power cos^phong_exponent stops mattering: at a cosine at most this,
+    // the power is at most 2^-specular_negligible_log2 (`specular_negligible`).
+    Real phong_negligible_below = -1;
 
     explicit Material(const scene::Material& m)
         : type(m.type), ambient(m.ambient), diffuse(m.diffuse), specular(m.specular), mirror(m.mirror),
           phong_exponent(Real(m.phong_exponent)), refraction_index(Real(m.refraction_index)),
           absorption_index(Real(m.absorption_index)), absorption_coefficient(m.absorption_coefficient),
           transparency(m.transparency), roughness(Real(m.roughness)),
-          brdf(make_brdf<Real>(m)), brdf_given(m.brdf.has_value()) {}
+          brdf(make_brdf<Real>(m)), brdf_given(m.brdf.has_value()),
+          phong_negligible_below(negligible_power_below(phong_exponent)) {}
+
+    // 2^-K with K = digits + 16 (40 in float, 69 in double): a power that small, times a
+    // specular coefficient of at most 2^13 times the diffuse term, is below half an ulp of it.
+    static constexpr int specular_negligible_log2 = std::numeric_limits<Real>::digits + 16;
+
+    // The largest cosine x (rounded down, then one more step) with x^exponent <= 2^-K; -1 where
+    // no cosine qualifies (an exponent of 0, negative or NaN, for which cos^0 = 1).
+    static Real negligible_power_below(Real exponent) {
+        if (!(exponent > 0)) return -1;
+        const double exact = std::exp2(-double(specular_negligible_log2) / double(exponent)) * (1 - 1e-9);
+        Real below = Real(exact);
+        if (double(below) > exact) below = std::nextafter(below, Real(0));
+        return below;
+    }
 };
 
 }  // namespace prism
