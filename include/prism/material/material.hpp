@@ -3,6 +3,7 @@
 #pragma once
 
 #include <prism/material/brdf.hpp>
+#include <prism/math/floating_point.hpp>
 #include <prism/math/vector.hpp>
 #include <prism/scene/scene.hpp>
 
@@ -24,7 +25,8 @@ struct Material {
     Brdf<Real> brdf;     // the course's original Blinn-Phong unless the material names a BRDF
     bool brdf_given = false;
     // Where the Blinn-Phong power cos^phong_exponent stops mattering: at a cosine at most this,
-    // the power is at most 2^-specular_negligible_log2 (`specular_negligible`).
+    // the power is at most 2^-specular_negligible_log2 (blinn_phong_power_negligible). Textures
+    // never change phong_exponent, so a textured copy keeps it right.
     Real phong_negligible_below = -1;
 
     explicit Material(const scene::Material& m)
@@ -49,5 +51,24 @@ struct Material {
         return below;
     }
 };
+
+// Whether diffuse + specular * cos_half^phong_exponent rounds to diffuse + specular * 0, so that
+// the power can be left out (glibc's powf was 11% of hw2 mirror_room, exponent 100 on every
+// material). Where cos_half <= material.phong_negligible_below the power is at most
+// 2^-K (1 + 2^-20), pow's own error included (glibc's: under 1 ulp); where each specular
+// coefficient times that is below its diffuse term times 2^-(digits + 3), the rounded product is
+// under half an ulp of the diffuse term, and the sum rounds back to it, as it does with the
+// product by 0. Negative coefficients and diffuse terms below 1e-20 take the power.
+template <Scalar Real>
+bool blinn_phong_power_negligible(const Material<Real>& material, Real cos_half, const Vec3<Real>& diffuse) {
+    if (!(cos_half <= material.phong_negligible_below)) return false;
+    static_assert(Material<Real>::specular_negligible_log2 == std::numeric_limits<Real>::digits + 16);
+    constexpr Real bound = unit_roundoff<Real> * Real(0x1p-16) * (1 + Real(0x1p-20));  // 2^-K (1 + 2^-20)
+    constexpr Real scale = unit_roundoff<Real> / 8;                                   // 2^-(digits + 3)
+    for (int c = 0; c < 3; ++c)
+        if (!(material.specular[c] >= 0 && diffuse[c] >= Real(1e-20) && material.specular[c] * bound < diffuse[c] * scale))
+            return false;
+    return true;
+}
 
 }  // namespace prism

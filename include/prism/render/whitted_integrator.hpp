@@ -12,14 +12,12 @@
 #include <prism/light/light_sample.hpp>
 #include <prism/material/fresnel.hpp>
 #include <prism/material/material.hpp>
-#include <prism/math/floating_point.hpp>
 #include <prism/render/integrator.hpp>
 #include <prism/sampling/random.hpp>
 #include <prism/texture/mipmap.hpp>
 
 #include <array>
 #include <cmath>
-#include <limits>
 #include <optional>
 #include <type_traits>
 #include <vector>
@@ -277,33 +275,16 @@ private:
             // A material without a specular colour (hw1 simple_reflectance's floor) skips the
             // power where it is finite, a base in [0, 1] and an exponent of at least 0: the term is
             // then specular * 0, the signed zeros the product gives (a NaN half vector, a base
-            // rounded past 1 or a negative exponent still take std::pow).
+            // rounded past 1 or a negative exponent still take std::pow). So does one whose power
+            // cannot change the sum (blinn_phong_power_negligible: most points away from a highlight).
             const Vec3<Real> diffuse = material.diffuse * cos_light;
             Vec3<Real> specular = material.specular * Real(0);
             if ((material.specular != Vec3<Real>(0) || !(cos_half <= 1) || !(material.phong_exponent >= 0)) &&
-                !specular_negligible(material, cos_half, diffuse))
+                !blinn_phong_power_negligible(material, cos_half, diffuse))
                 specular = material.specular * std::pow(cos_half, material.phong_exponent);
             color += (diffuse + specular) * sample.radiance;
         });
         return color;
-    }
-
-    // Whether diffuse + specular * cos_half^exponent rounds to diffuse + specular * 0, without the
-    // power (glibc's powf was 11% of hw2 mirror_room, exponent 100 on every material): where
-    // cos_half <= material.phong_negligible_below the power is at most 2^-K (1 + 2^-20), pow's
-    // own error included (glibc: under 1 ulp), and where each specular coefficient times that is
-    // below diffuse 2^-(digits + 3), the rounded product is under half an ulp of the diffuse
-    // term, so the sum rounds back to it, as it does with the product by 0 (non-negative
-    // coefficients, diffuse terms of at least 1e-20; anything else takes the power).
-    static bool specular_negligible(const Material<Real>& material, Real cos_half, const Vec3<Real>& diffuse) {
-        if (!(cos_half <= material.phong_negligible_below)) return false;
-        static_assert(Material<Real>::specular_negligible_log2 == std::numeric_limits<Real>::digits + 16);
-        constexpr Real bound = unit_roundoff<Real> * Real(0x1p-16) * (1 + Real(0x1p-20));  // 2^-K (1 + 2^-20)
-        constexpr Real scale = unit_roundoff<Real> / 8;                                   // 2^-(digits + 3)
-        for (int c = 0; c < 3; ++c)
-            if (!(material.specular[c] >= 0 && diffuse[c] >= Real(1e-20) && material.specular[c] * bound < diffuse[c] * scale))
-                return false;
-        return true;
     }
 
     Vec3<Real> dielectric(const SurfacePoint<Real>& point, const Vec3<Real>& d, const Vec3<Real>& normal,
