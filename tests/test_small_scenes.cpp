@@ -1,5 +1,5 @@
 // The shortcuts of scenes of a few spheres and planes, for float and double: a top level of at
-// most 8 spheres tested one after another (SceneGeometry's direct spheres) finds the hits and
+// most 4 spheres tested one after another (SceneGeometry's direct spheres) finds the hits and
 // the occlusions the top-level index finds, bit for bit, on random and grazing rays, with and
 // without a world-space mesh beside it, for plain, translated and scaled-rotated spheres; and
 // Blinn-Phong's power is left out only where the sum it enters is the same without it.
@@ -60,7 +60,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: a top level of a few spheres tested directly 
         CAPTURE(with_mesh);
         const scene::Scene direct_world = few_spheres(with_mesh);
         // Five more spheres, tiny and far beyond every ray's reach (t_max below), take the top
-        // level past the direct test's limit of 8: the same objects, through the index.
+        // level past the direct test's limit of 4: the same objects, through the index.
         scene::Scene indexed_world = direct_world;
         for (int i = 0; i < 5; ++i)
             indexed_world.spheres.push_back({"far", 0, {1e4 + 10 * i, 1e4, 1e4}, 1e-3, glm::dmat4(1.0)});

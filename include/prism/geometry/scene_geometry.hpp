@@ -582,13 +582,16 @@ private:
         return spheres_[instance.shape].intersect(local, ray.t_min, t_max, t) && t < t_max;
     }
 
-    // A top level of a few spheres and nothing else (the course's sphere scenes: 2 to 7) is
+    // A top level of a few spheres and nothing else (the course's sphere scenes of 1 to 4) is
     // tested sphere after sphere, without the index: the traversal's prepared ray (three
     // divisions, broadcast) and its node test cost more than the spheres (hw2 mirror_room: the
     // prepared ray alone was 15% of the time). Each sphere is tested as the index's leaf tests
     // it, so the hits are the same; only two spheres hit at exactly the same distance could
     // resolve otherwise (the later one tested wins in both).
-    static constexpr std::size_t direct_sphere_limit = 8;
+    // Up to 4: with 5 and 6 untransformed spheres (hw1 spheres_with_plane, spheres.json) the
+    // index's one 8-wide box test was cheaper than the spheres' tests (1.04-1.05 of base's CPU
+    // time); with 2 and 4 (mirror_room, mirror_spheres) the direct test took 0.89 and 0.83.
+    static constexpr std::size_t direct_sphere_limit = 4;
     struct DirectSphere {
         std::uint32_t object = 0;
         // How the ray reaches object space: unchanged, moved by `translation` (a transform that
