@@ -20,7 +20,9 @@
 #include <prism/scene/scene.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <type_traits>
@@ -46,10 +48,16 @@ struct PlaneShape {
     Vec3<Real> point{0};
     Vec3<Real> normal{0, 1, 0};  // unit
 
-    bool intersect(const Ray<Real>& ray, Real t_min, Real t_max, Real& t_hit) const {
+    // Forced inline: out of line, the planes' loop in front of every shadow ray's light took 17%
+    // of hw2 mirror_room (5 planes).
+    [[gnu::always_inline]] bool intersect(const Ray<Real>& ray, Real t_min, Real t_max, Real& t_hit) const {
         const Real denominator = glm::dot(ray.direction, normal);
         if (denominator == 0) return false;
-        const Real t = glm::dot(point - ray.origin, normal) / denominator;
+        const Real numerator = glm::dot(point - ray.origin, normal);
+        // Opposite signs (or a zero numerator) give a t of at most 0, which no t_min >= 0
+        // accepts: the division is left out (planes behind the ray, half of a room's walls).
+        if (t_min >= 0 && (numerator == 0 || std::signbit(numerator) != std::signbit(denominator))) return false;
+        const Real t = numerator / denominator;
         if (!(t > t_min && t <= t_max)) return false;
         t_hit = t;
         return true;
@@ -133,6 +141,7 @@ public:
         top_options.max_leaf_size = 1;
         if constexpr (requires { Index::build(boxes, top_options); }) top_ = Index::build(boxes, top_options);
         else top_ = Index::build(boxes);
+        choose_direct_spheres(scene);
     }
 
     std::size_t instance_count() const { return instances_.size(); }
@@ -168,6 +177,7 @@ public:
     // (geometry/backface_culling.hpp).
     template <BackfaceCulling Culling = BackfaceCulling::none>
     bool intersect(Ray<Real>& ray, Hit<Real>& hit) const {
+        if (world_meshes_.empty() && !direct_spheres_.empty()) return intersect_direct<Culling>(ray, hit, false);
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;  // made when the ray first enters a mesh
         // The merged world-space meshes first: their hit lowers t_max before the top level
@@ -188,6 +198,7 @@ public:
                 found = true;
             }
         }
+        if (!direct_spheres_.empty()) return intersect_direct<Culling>(ray, hit, found);
         if (top_objects_.empty()) return intersect_planes<Culling>(ray, hit) || found;
         const auto& order = top_.primitive_indices();
         top_.traverse_closest(traversal_ray, ray.t_min, ray.t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_max) {
@@ -226,6 +237,7 @@ public:
 
     // Whether anything lies in (ray.t_min, ray.t_max).
     bool occluded(const Ray<Real>& ray) const {
+        if (world_meshes_.empty() && !direct_spheres_.empty()) return occluded_direct(ray);
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;
         std::optional<RayBoxPrecomputed<Real>> box_ray;
@@ -235,6 +247,7 @@ public:
             if (!world_triangle_ray) world_triangle_ray.emplace(ray);
             if (index.occluded(ray, traversal_ray, *world_triangle_ray, ray.t_max)) return true;
         }
+        if (!direct_spheres_.empty()) return occluded_direct(ray);
         const auto& order = top_.primitive_indices();
         const bool blocked =
             !top_objects_.empty() &&
@@ -576,6 +589,117 @@ private:
         return spheres_[instance.shape].intersect(local, ray.t_min, t_max, t) && t < t_max;
     }
 
+    // A top level of a few spheres and nothing else (the course's sphere scenes of 1 to 4) is
+    // tested sphere after sphere, without the index: the traversal's prepared ray (three
+    // divisions, broadcast) and its node test cost more than the spheres (hw2 mirror_room: the
+    // prepared ray alone was 15% of the time). Each sphere is tested as the index's leaf tests
+    // it, so the hits are the same; only two spheres hit at exactly the same distance could
+    // resolve otherwise (the later one tested wins in both).
+    // Up to 4: with 5 and 6 untransformed spheres (hw1 spheres_with_plane, spheres.json) the
+    // index's one 8-wide box test was cheaper than the spheres' tests (1.04-1.05 of base's CPU
+    // time); with 2 and 4 (mirror_room, mirror_spheres) the direct test took 0.89 and 0.83.
+    static constexpr std::size_t direct_sphere_limit = 4;
+    struct DirectSphere {
+        std::uint32_t object = 0;
+        // How the ray reaches object space: unchanged, moved by `translation` (a transform that
+        // only translates: the matrix product's answer, ox + tx with zero terms, bit for bit),
+        // or by the instance's matrix.
+        enum class Map : std::uint8_t { none, translation, matrix } map = Map::none;
+        Vec3<Real> translation{0};
+        // A world-space sphere around the object, widened so that may_hit never rejects a ray
+        // the object-space test hits: it culls as the index's box did.
+        Vec3<Real> center{0};
+        Real radius_squared = 0;
+    };
+
+    void choose_direct_spheres(const scene::Scene& scene) {
+        if (top_objects_.empty() || top_objects_.size() > direct_sphere_limit) return;
+        const std::size_t first_sphere = scene.meshes.size() + scene.mesh_instances.size();
+        std::vector<DirectSphere> chosen;
+        for (const std::uint32_t object : top_objects_) {
+            const Instance& instance = instances_[object];
+            if (instance.kind != Kind::sphere || instance.moving) return;
+            DirectSphere direct;
+            direct.object = object;
+            if (instance.transformed) {
+                direct.map = Mat3<Real>(instance.world_to_object) == Mat3<Real>(1) ? DirectSphere::Map::translation
+                                                                                   : DirectSphere::Map::matrix;
+                direct.translation = Vec3<Real>(instance.world_to_object[3]);
+            }
+            // |M (c + r u) - M c| <= r ||M||_2, and ||M||_2 <= min(||M||_F, sqrt(||M||_1 ||M||_inf)):
+            // 1 for a translation, the largest factor for a scaling. Widened by 0.1% for the
+            // rounded matrices and the object-space test's rounding.
+            const scene::Sphere& source = scene.spheres[object - first_sphere];
+            const glm::dmat3 linear(source.transform);
+            double frobenius = 0, columns = 0, rows = 0;
+            for (int i = 0; i < 3; ++i) {
+                frobenius += glm::dot(linear[i], linear[i]);
+                columns = std::max(columns, std::abs(linear[i][0]) + std::abs(linear[i][1]) + std::abs(linear[i][2]));
+                rows = std::max(rows, std::abs(linear[0][i]) + std::abs(linear[1][i]) + std::abs(linear[2][i]));
+            }
+            const double radius = source.radius * std::sqrt(std::min(frobenius, columns * rows)) * (1 + 1e-3);
+            direct.center = Vec3<Real>(glm::dvec3(source.transform * glm::dvec4(source.center, 1.0)));
+            direct.radius_squared = Real(radius * radius);
+            chosen.push_back(direct);
+        }
+        direct_spheres_ = std::move(chosen);
+    }
+
+    // Whether the ray may meet the object inside `sphere`: false only where it surely misses,
+    // starting outside and leaving, or passing wider than the radius (a |oc|^2 - b^2 > a r^2,
+    // no division). The rounded oc, b and products are off by at most 8 epsilon a |oc|^2 in
+    // all (the cancellation when the ray aims at the centre); the test allows twice that.
+    [[gnu::always_inline]] static bool may_hit(const DirectSphere& sphere, const Ray<Real>& ray) {
+        const Vec3<Real> oc = ray.origin - sphere.center;
+        const Real b = glm::dot(oc, ray.direction);
+        const Real distance_squared = glm::dot(oc, oc);
+        if (b >= 0 && distance_squared > sphere.radius_squared && ray.t_min >= 0) return false;
+        const Real a = glm::dot(ray.direction, ray.direction);
+        return a * distance_squared - b * b <=
+               a * (sphere.radius_squared + 16 * std::numeric_limits<Real>::epsilon() * distance_squared);
+    }
+
+    // Whether the ray meets `sphere` in (ray.t_min, t_max], tested in object space as the index's
+    // leaf tests it (to_object).
+    [[gnu::always_inline]] bool direct_hit(const DirectSphere& sphere, const Ray<Real>& ray, Real t_max, Real& t) const {
+        if (!may_hit(sphere, ray)) return false;
+        const Instance& instance = instances_[sphere.object];
+        const SphereShape<Real>& shape = spheres_[instance.shape];
+        switch (sphere.map) {
+            case DirectSphere::Map::none: return shape.intersect(ray, ray.t_min, t_max, t);
+            case DirectSphere::Map::translation: {
+                Ray<Real> local = ray;
+                local.origin = ray.origin + sphere.translation;
+                return shape.intersect(local, ray.t_min, t_max, t);
+            }
+            case DirectSphere::Map::matrix: break;
+        }
+        return shape.intersect(instance.to_object(ray), ray.t_min, t_max, t);
+    }
+
+    // intersect's top level and planes for direct_spheres_; `found`: a world mesh was hit.
+    template <BackfaceCulling Culling>
+    bool intersect_direct(Ray<Real>& ray, Hit<Real>& hit, bool found) const {
+        for (const DirectSphere& sphere : direct_spheres_) {
+            Real t;
+            if (!direct_hit(sphere, ray, ray.t_max, t)) continue;
+            ray.t_max = t;
+            hit.t = t;
+            hit.primitive = 0;
+            hit.object = sphere.object;
+            found = true;
+        }
+        return intersect_planes<Culling>(ray, hit) || found;
+    }
+
+    bool occluded_direct(const Ray<Real>& ray) const {
+        for (const DirectSphere& sphere : direct_spheres_) {
+            Real t;
+            if (direct_hit(sphere, ray, ray.t_max, t) && t < ray.t_max) return true;
+        }
+        return occluded_by_planes(ray);
+    }
+
     // The merged meshes of one culling class and the index over their triangles.
     struct WorldMeshes {
         // Over the parts' triangles, numbered part after part; none for a single part, which
@@ -599,6 +723,7 @@ private:
     std::vector<TriangleMesh<Real, Policy>> meshes_;
     std::vector<WorldMeshes> world_meshes_;
     std::vector<std::uint32_t> top_objects_;  // the top level's primitives: the objects not merged
+    std::vector<DirectSphere> direct_spheres_;  // the top level's objects, when tested without it
     Aabb<Real> bounds_;
     std::vector<SphereShape<Real>> spheres_;
     std::vector<PlaneShape<Real>> planes_;

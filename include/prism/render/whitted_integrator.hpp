@@ -275,11 +275,14 @@ private:
             // A material without a specular colour (hw1 simple_reflectance's floor) skips the
             // power where it is finite, a base in [0, 1] and an exponent of at least 0: the term is
             // then specular * 0, the signed zeros the product gives (a NaN half vector, a base
-            // rounded past 1 or a negative exponent still take std::pow).
+            // rounded past 1 or a negative exponent still take std::pow). So does one whose power
+            // cannot change the sum (blinn_phong_power_negligible: most points away from a highlight).
+            const Vec3<Real> diffuse = material.diffuse * cos_light;
             Vec3<Real> specular = material.specular * Real(0);
-            if (material.specular != Vec3<Real>(0) || !(cos_half <= 1) || !(material.phong_exponent >= 0))
+            if ((material.specular != Vec3<Real>(0) || !(cos_half <= 1) || !(material.phong_exponent >= 0)) &&
+                !blinn_phong_power_negligible(material, cos_half, diffuse))
                 specular = material.specular * std::pow(cos_half, material.phong_exponent);
-            color += (material.diffuse * cos_light + specular) * sample.radiance;
+            color += (diffuse + specular) * sample.radiance;
         });
         return color;
     }

@@ -1,0 +1,169 @@
+// The shortcuts of scenes of a few spheres and planes, for float and double: a top level of at
+// most 4 spheres tested one after another (SceneGeometry's direct spheres) finds the hits and
+// the occlusions the top-level index finds, bit for bit, on random and grazing rays, with and
+// without a world-space mesh beside it, for plain, translated and scaled-rotated spheres; and
+// Blinn-Phong's power is left out only where the sum it enters is the same without it.
+#include <prism/geometry/scene_geometry.hpp>
+#include <prism/material/material.hpp>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <random>
+#include <vector>
+
+namespace {
+
+namespace scene = prism::scene;
+
+// Spheres of every kind the direct test distinguishes, a plane, and optionally a floor of two
+// triangles (a world-space mesh, tested before the top level).
+scene::Scene few_spheres(bool with_mesh) {
+    scene::Scene world;
+    world.materials.push_back({});
+    world.spheres.push_back({"plain", 0, {0, 0, 0}, 1.0, glm::dmat4(1.0)});
+    world.spheres.push_back({"translated", 0, {0.5, 0, 0}, 0.75,
+                             glm::translate(glm::dmat4(1.0), glm::dvec3(2.5, 0.25, -1))});
+    glm::dmat4 ellipsoid = glm::translate(glm::dmat4(1.0), glm::dvec3(-2.5, 0.5, 0.5));
+    ellipsoid = glm::rotate(ellipsoid, 0.7, glm::normalize(glm::dvec3(1, 2, 3)));
+    ellipsoid = glm::scale(ellipsoid, glm::dvec3(1.5, 0.25, 0.8));
+    world.spheres.push_back({"ellipsoid", 0, {0, 0.2, 0}, 1.0, ellipsoid});
+    world.spheres.push_back({"flattened", 0, {0, 0, 0}, 0.5,
+                             glm::scale(glm::translate(glm::dmat4(1.0), glm::dvec3(0, 2.5, 0)), glm::dvec3(3, 0.1, 3))});
+    world.planes.push_back({"wall", 0, {0, 0, -4}, glm::normalize(glm::dvec3(0.1, 0.2, 1)), glm::dmat4(1.0)});
+    if (with_mesh) {
+        scene::Mesh floor;
+        floor.positions = {{-6, -1.5, -6}, {6, -1.5, -6}, {6, -1.5, 6}, {-6, -1.5, 6}};
+        floor.triangles = {{0, 2, 1}, {0, 3, 2}};
+        world.meshes.push_back(floor);
+    }
+    return world;
+}
+
+template <class Real>
+bool same_bits(Real a, Real b) {
+    return std::memcmp(&a, &b, sizeof(Real)) == 0;
+}
+
+}  // namespace
+
+TEST_CASE_TEMPLATE("SceneGeometry: a top level of a few spheres tested directly finds what the index finds", Real, float,
+                   double) {
+    using Geometry = prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>;
+    for (const bool with_mesh : {false, true}) {
+        for (const prism::BackfaceCulling culling : {prism::BackfaceCulling::none, prism::BackfaceCulling::flat_triangles}) {
+        CAPTURE(int(culling));
+        CAPTURE(with_mesh);
+        const scene::Scene direct_world = few_spheres(with_mesh);
+        // Five more spheres, tiny and far beyond every ray's reach (t_max below), take the top
+        // level past the direct test's limit of 4: the same objects, through the index.
+        scene::Scene indexed_world = direct_world;
+        for (int i = 0; i < 5; ++i)
+            indexed_world.spheres.push_back({"far", 0, {1e4 + 10 * i, 1e4, 1e4}, 1e-3, glm::dmat4(1.0)});
+        const Geometry direct(direct_world), indexed(indexed_world);
+
+        std::mt19937 random(7);
+        std::uniform_real_distribution<double> uniform(-1, 1);
+        const auto unit = [&] {
+            glm::dvec3 v;
+            do v = {uniform(random), uniform(random), uniform(random)};
+            while (glm::dot(v, v) > 1 || glm::dot(v, v) < 1e-6);
+            return glm::normalize(v);
+        };
+        // Points on each sphere's surface, in world space, for rays that pass through them or
+        // just graze them (the rays the bounding spheres' margins are for).
+        const auto surface_point = [&](std::size_t s) {
+            const scene::Sphere& sphere = direct_world.spheres[s];
+            return glm::dvec3(sphere.transform * glm::dvec4(sphere.center + sphere.radius * unit(), 1.0));
+        };
+        std::size_t hits = 0, blocked = 0, rays = 0;
+        for (int i = 0; i < 60000; ++i) {
+            glm::dvec3 origin, direction;
+            if (i % 2 == 0) {
+                origin = 5.0 * glm::dvec3(uniform(random), uniform(random), uniform(random));
+                direction = unit();
+            } else {
+                const glm::dvec3 target = surface_point(std::size_t(i / 2) % direct_world.spheres.size());
+                origin = target + (1 + 4 * std::abs(uniform(random))) * unit();
+                direction = glm::normalize(target - origin);
+                if (i % 4 == 1) direction = glm::normalize(direction + 1e-4 * unit());  // grazing, either side
+            }
+            prism::Ray<Real> ray{prism::Vec3<Real>(origin), prism::Vec3<Real>(direction), Real(0), Real(50)};
+            if (i % 3 == 0) ray.t_max = Real(3 * std::abs(uniform(random)));
+            ++rays;
+            prism::Ray<Real> a = ray, b = ray;
+            prism::Hit<Real> hit_a, hit_b;
+            const bool found_a = culling == prism::BackfaceCulling::none
+                                     ? direct.intersect(a, hit_a)
+                                     : direct.template intersect<prism::BackfaceCulling::flat_triangles>(a, hit_a);
+            const bool found_b = culling == prism::BackfaceCulling::none
+                                     ? indexed.intersect(b, hit_b)
+                                     : indexed.template intersect<prism::BackfaceCulling::flat_triangles>(b, hit_b);
+            REQUIRE(found_a == found_b);
+            CHECK(direct.occluded(ray) == indexed.occluded(ray));
+            if (!found_a) continue;
+            ++hits;
+            blocked += direct.occluded(ray);
+            CHECK(same_bits(hit_a.t, hit_b.t));
+            CHECK(same_bits(a.t_max, b.t_max));
+            // Planes are numbered after the objects, so past the far spheres in the indexed scene.
+            const auto plane_or_object = [](const Geometry& geometry, std::uint32_t object) {
+                return object >= geometry.instance_count() ? 1000 + (object - geometry.instance_count()) : std::size_t(object);
+            };
+            CHECK(plane_or_object(direct, hit_a.object) == plane_or_object(indexed, hit_b.object));
+            CHECK(hit_a.primitive == hit_b.primitive);
+        }
+        // Most rays meet something: the comparison is not of misses alone.
+        CHECK(hits > rays / 3);
+        CHECK(blocked > rays / 4);
+        }
+    }
+}
+
+TEST_CASE_TEMPLATE("Blinn-Phong: the power is left out only where the sum is the same without it", Real, float, double) {
+    using Vec3 = prism::Vec3<Real>;
+    std::mt19937 random(11);
+    std::uniform_real_distribution<double> uniform(0, 1);
+    const Real power_bound = std::ldexp(Real(1), -prism::Material<Real>::specular_negligible_log2);
+    for (const double exponent : {0.5, 1.0, 10.0, 100.0, 1000.0, 1e6}) {
+        CAPTURE(exponent);
+        scene::Material description;
+        description.phong_exponent = exponent;
+        prism::Material<Real> material(description);
+        const Real below = material.phong_negligible_below;
+        REQUIRE(below > 0);
+        REQUIRE(below < 1);
+        // Up to the threshold the power is at most 2^-K, the bound the shortcut relies on.
+        CHECK(std::pow(below, material.phong_exponent) <= power_bound);
+        // A cosine of 1 always takes the power; so does a zero diffuse term under a specular one.
+        material.specular = Vec3(1);
+        CHECK_FALSE(prism::blinn_phong_power_negligible(material, Real(1), Vec3(1)));
+        CHECK_FALSE(prism::blinn_phong_power_negligible(material, below, Vec3(1, 0, 1)));
+        CHECK(prism::blinn_phong_power_negligible(material, below, Vec3(1)));
+        std::size_t skipped = 0;
+        for (int i = 0; i < 200000; ++i) {
+            const Real cos_half = Real(2 * uniform(random)) * below;  // half of them past the threshold
+            material.specular = Vec3(Real(uniform(random)), Real(uniform(random)), i % 5 == 0 ? Real(0) : Real(uniform(random)));
+            const Real cos_light = Real(uniform(random));
+            const Vec3 diffuse = Vec3(Real(uniform(random)), Real(uniform(random)), Real(uniform(random))) * cos_light;
+            if (!prism::blinn_phong_power_negligible(material, cos_half, diffuse)) continue;
+            ++skipped;
+            REQUIRE(cos_half <= below);
+            const Vec3 with = diffuse + material.specular * std::pow(cos_half, material.phong_exponent);
+            const Vec3 without = diffuse + material.specular * Real(0);
+            for (int c = 0; c < 3; ++c) CHECK(same_bits(with[c], without[c]));
+        }
+        CHECK(skipped > 50000);
+    }
+    // No exponent above 0, no threshold: cos^0 = 1 is never negligible.
+    for (const double exponent : {0.0, -2.0, std::nan("")}) {
+        scene::Material description;
+        description.phong_exponent = exponent;
+        const prism::Material<Real> material(description);
+        CHECK_FALSE(prism::blinn_phong_power_negligible(material, Real(0), Vec3(1)));
+    }
+}
