@@ -713,6 +713,62 @@ TEST_CASE_TEMPLATE("BVH built from a box function: the same trees as from an arr
     check_wide(std::integral_constant<int, 8>{});
 }
 
+TEST_CASE_TEMPLATE("BVH built on two threads: the same trees as on one", Real, float, double) {
+    // Large nodes bin, partition and make their boxes in parallel runs merged in order, and the
+    // collapse plans subtrees as tasks: the trees must be the one-thread trees. 81,920
+    // triangles: the root and its children take the parallel passes (2 x 16,384 and more).
+    std::vector<glm::dvec3> positions;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    perturbed_sphere(6, 13, positions, triangles);
+    REQUIRE(triangles.size() >= 4 * 16384);
+    const auto boxes = triangle_boxes<Real>(positions, triangles);
+    const auto built_on = [&]<class Tree>(std::size_t threads, const Tree*) {
+        const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+        return Tree::build(boxes);
+    };
+    const auto same_box = [](const prism::Aabb<Real>& a, const prism::Aabb<Real>& b) {
+        return std::memcmp(&a, &b, sizeof a) == 0;  // bit for bit, the sign of a zero included
+    };
+    {
+        using Tree = prism::BvhTree<Real>;
+        const Tree one = built_on(1, (const Tree*)nullptr), two = built_on(2, (const Tree*)nullptr);
+        REQUIRE(one.nodes().size() == two.nodes().size());
+        CHECK(one.primitive_indices() == two.primitive_indices());
+        // Depth first: parallel tasks number the nodes in the order they run.
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> todo{{0, 0}};
+        std::size_t different = 0, visited = 0;
+        while (!todo.empty()) {
+            const auto [i, j] = todo.back();
+            todo.pop_back();
+            const auto &a = one.nodes()[i], &b = two.nodes()[j];
+            ++visited;
+            different += !same_box(a.bounds, b.bounds) || a.count != b.count || (a.is_leaf() && a.index != b.index);
+            if (!a.is_leaf() && !b.is_leaf()) {
+                todo.push_back({a.index, b.index});
+                todo.push_back({a.index + 1, b.index + 1});
+            }
+        }
+        CHECK(visited == one.nodes().size());
+        CHECK(different == 0);
+    }
+    const auto check_wide = [&]<int N>(std::integral_constant<int, N>) {
+        using Tree = prism::WideBvhTree<Real, N>;
+        const Tree one = built_on(1, (const Tree*)nullptr), two = built_on(2, (const Tree*)nullptr);
+        REQUIRE(one.nodes().size() == two.nodes().size());
+        std::size_t different = 0;  // field by field: a node of double lanes has padding
+        for (std::size_t i = 0; i < one.nodes().size(); ++i) {
+            const auto &a = one.nodes()[i], &b = two.nodes()[i];
+            different += std::memcmp(a.bounds, b.bounds, sizeof a.bounds) != 0 || std::memcmp(a.child, b.child, sizeof a.child) != 0 ||
+                         std::memcmp(a.count, b.count, sizeof a.count) != 0;
+        }
+        CHECK(different == 0);
+        CHECK(one.primitive_indices() == two.primitive_indices());
+        CHECK(same_box(one.bounds(), two.bounds()));
+    };
+    check_wide(std::integral_constant<int, 4>{});
+    check_wide(std::integral_constant<int, 8>{});
+}
+
 TEST_CASE("HugePageAllocator: aligned for its type below and above a huge page, huge-page aligned above") {
     // The builder's boxes of double lanes ask for 32 bytes, more than operator new's default.
     struct alignas(32) Wide {

@@ -10,7 +10,6 @@
 #include <prism/simd/prefetch.hpp>
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
 
@@ -59,10 +58,11 @@ public:
         return build(static_cast<std::uint32_t>(boxes.size()), [boxes](std::uint32_t i) { return boxes[i]; }, options);
     }
 
-    // The same from `box_of(i)`, the box of primitive i, asked once per primitive in order: a
-    // caller that makes its boxes (a mesh from its triangles) hands them straight to the
-    // builder's own array instead of filling one of its own first (on the 766k-triangle dragon
-    // an 18 MB array written, faulted in and read back once).
+    // The same from `box_of(i)`, the box of primitive i, asked once per primitive: a caller
+    // that makes its boxes (a mesh from its triangles) hands them straight to the builder's own
+    // array instead of filling one of its own first (on the 766k-triangle dragon an 18 MB array
+    // written, faulted in and read back once). Below 2 setup_grain primitives it is asked in
+    // order on one thread; above, from every thread at once, in runs.
     template <class BoxOf>
         requires std::is_invocable_r_v<Aabb<Real>, const BoxOf&, std::uint32_t>
     static BvhTree build(std::uint32_t count, const BoxOf& box_of, const BvhBuildOptions& options = {}) {
@@ -315,10 +315,6 @@ private:
         static constexpr std::uint32_t scratch_on_stack = 1024;
 
         static constexpr int max_bins = 64;
-        // The runs a node of at least 2 setup_grain primitives splits its passes into.
-        static constexpr std::uint32_t parallel_runs = 8;
-        // A partition's children's centroid bounds, [2 * odd + left] (see build).
-        using CentroidLanes = std::array<BuildBox, 4>;
         // Below this many primitives one set of bins is used (resetting and merging a second
         // costs more than the stalls it saves).
         static constexpr std::uint32_t two_bin_sets_from = 64;
@@ -415,41 +411,17 @@ private:
             // the order, so the bins (and the tree) are the same.
             BinSet bins, odd_bins;
             bins.reset(bin_count);
-            // Primitives [first, last) of the range into a set for the even and one for the odd.
-            const auto bin_run = [&](std::uint32_t first, std::uint32_t last, BinSet& even, BinSet& odd) {
-                std::uint32_t i = first;
-                for (; i + 1 < last; i += 2) {
+            if (count >= two_bin_sets_from) {
+                odd_bins.reset(bin_count);
+                std::uint32_t i = 0;
+                for (; i + 1 < count; i += 2) {
                     // As in the partition: the largest nodes stream their boxes from memory,
                     // and the box loads were this loop's hottest instructions.
-                    simd::prefetch(range[std::min(i + 16, last - 1)]);
-                    even.add<false>(range[i], bins_of(range[i]));
-                    odd.add<false>(range[i + 1], bins_of(range[i + 1]));
+                    simd::prefetch(range[std::min(i + 16, count - 1)]);
+                    bins.add<false>(range[i], bins_of(range[i]));
+                    odd_bins.add<false>(range[i + 1], bins_of(range[i + 1]));
                 }
-                if (i < last) even.add<false>(range[i], bins_of(range[i]));
-            };
-            if (count >= 2 * setup_grain) {
-                // The largest nodes (the root, and the children of an uneven split), which no
-                // other task runs beside, bin in parallel: runs of an even length, so every
-                // primitive keeps its parity, each into sets of its own, merged in the runs'
-                // order. Each set then sees its primitives in the one-loop order, which keeps
-                // the bounds' bits.
-                const std::uint32_t runs = std::min(parallel_runs, count / setup_grain);
-                const std::uint32_t length = (count / runs + 2) & ~std::uint32_t(1);
-                std::vector<std::array<BinSet, 2>> run_bins(runs);
-                tbb::parallel_for(std::uint32_t(0), runs, [&](std::uint32_t r) {
-                    run_bins[r][0].reset(bin_count);
-                    run_bins[r][1].reset(bin_count);
-                    bin_run(r * length, std::min(count, (r + 1) * length), run_bins[r][0], run_bins[r][1]);
-                });
-                odd_bins.reset(bin_count);
-                for (const auto& [even, odd] : run_bins) {
-                    bins.merge(even, bin_count);
-                    odd_bins.merge(odd, bin_count);
-                }
-                bins.merge(odd_bins, bin_count);
-            } else if (count >= two_bin_sets_from) {
-                odd_bins.reset(bin_count);
-                bin_run(0, count, bins, odd_bins);
+                if (i < count) bins.add<false>(range[i], bins_of(range[i]));
                 bins.merge(odd_bins, bin_count);
             } else {
                 for (std::uint32_t i = 0; i < count; ++i) bins.add(range[i], bins_of(range[i]));
@@ -523,18 +495,17 @@ private:
                 // loop's hottest instruction on the dragon). The lanes that matter take the same
                 // values in either order; only the sign of a zero bound may differ, and
                 // (c - low) * scale bins a centroid the same for +0 and -0.
-                CentroidLanes centroid_lanes;  // [2 * odd + left]
+                std::array<BuildBox, 4> centroid_lanes;  // [2 * odd + left]
                 centroid_lanes.fill(BuildBox::empty());
-                const auto goes_left = [&](const BuildBox& box, std::uint32_t odd, CentroidLanes& lanes)
-                                           __attribute__((always_inline)) {
+                const auto goes_left = [&](const BuildBox& box, std::uint32_t odd) __attribute__((always_inline)) {
                     Lanes centroid, position;
                     box.centroid(centroid);
                     bin_positions(centroid, position);
                     const bool left = std::min(bin_count - 1, int(position[best_axis])) < best_split;
-                    lanes[2 * odd + left].extend(centroid);
+                    centroid_lanes[2 * odd + left].extend(centroid);
                     return left;
                 };
-                middle = begin + partition(begin, end, goes_left, centroid_lanes);
+                middle = begin + partition(begin, end, goes_left);
                 centroid_lanes[0].extend(centroid_lanes[2]);
                 centroid_lanes[1].extend(centroid_lanes[3]);
                 left_centroids = centroid_lanes[1].aabb();
@@ -565,8 +536,7 @@ private:
         // per primitive that the data mispredicts half the time; here the same pairs are found
         // in branch-free passes: each primitive's side, then the misplaced ones of each part.
         template <class GoesLeft>
-        std::uint32_t partition(std::uint32_t begin, std::uint32_t end, const GoesLeft& goes_left,
-                                CentroidLanes& centroid_lanes) {
+        std::uint32_t partition(std::uint32_t begin, std::uint32_t end, const GoesLeft& goes_left) {
             const std::uint32_t count = end - begin;
             // moves takes at most count slots: the front pass writes slot misplaced <= i below
             // left_count, the back pass slots misplaced + found, where misplaced (right-goers
@@ -582,36 +552,14 @@ private:
             // In a local: a store to sides (bytes, which may alias anything) made the compiler
             // reload the member before every box.
             BuildBox* const range = boxes + begin;
-            const auto find_sides = [&](std::uint32_t first, std::uint32_t last, CentroidLanes& lanes) {
-                std::uint32_t left_count = 0;
-                for (std::uint32_t i = first; i < last; ++i) {
-                    // Large nodes stream their boxes from memory, and this loop's chain of
-                    // side-indexed updates leaves the hardware prefetcher behind: ask half a
-                    // kilobyte ahead.
-                    simd::prefetch(range[std::min(i + 16, last - 1)]);
-                    const bool left = goes_left(range[i], i & 1u, lanes);
-                    sides[i] = left;
-                    left_count += left;
-                }
-                return left_count;
-            };
             std::uint32_t left_count = 0;
-            if (count >= 2 * setup_grain) {
-                // As the binning: runs in parallel, each with bounds of its own, joined in order.
-                const std::uint32_t runs = std::min(parallel_runs, count / setup_grain);
-                const std::uint32_t length = count / runs + 1;
-                std::vector<CentroidLanes> run_lanes(runs);
-                std::vector<std::uint32_t> run_left(runs);
-                tbb::parallel_for(std::uint32_t(0), runs, [&](std::uint32_t r) {
-                    run_lanes[r].fill(BuildBox::empty());
-                    run_left[r] = find_sides(r * length, std::min(count, (r + 1) * length), run_lanes[r]);
-                });
-                for (std::uint32_t r = 0; r < runs; ++r) {
-                    for (int k = 0; k < 4; ++k) centroid_lanes[k].extend(run_lanes[r][k]);
-                    left_count += run_left[r];
-                }
-            } else {
-                left_count = find_sides(0, count, centroid_lanes);
+            for (std::uint32_t i = 0; i < count; ++i) {
+                // Large nodes stream their boxes from memory, and this loop's chain of side-indexed
+                // updates leaves the hardware prefetcher behind: ask half a kilobyte ahead.
+                simd::prefetch(range[std::min(i + 16, count - 1)]);
+                const bool left = goes_left(range[i], i & 1u);
+                sides[i] = left;
+                left_count += left;
             }
             // Right-goers in the front part, first to last; then left-goers in the back part,
             // last to first. There are as many of each; every slot is written, kept or not.
@@ -626,18 +574,9 @@ private:
                 from_back[found] = i;
                 found += sides[i];
             }
-            // The pairs are disjoint: a large node swaps them in parallel.
-            const auto swap_pairs = [&](std::uint32_t first, std::uint32_t last) {
-                for (std::uint32_t k = first; k < last; ++k) {
-                    std::swap(range[moves[k]], range[from_back[k]]);
-                    std::swap(indices[begin + moves[k]], indices[begin + from_back[k]]);
-                }
-            };
-            if (misplaced >= 2 * setup_grain) {
-                tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, misplaced, setup_grain),
-                                  [&](const tbb::blocked_range<std::uint32_t>& run) { swap_pairs(run.begin(), run.end()); });
-            } else {
-                swap_pairs(0, misplaced);
+            for (std::uint32_t k = 0; k < misplaced; ++k) {
+                std::swap(range[moves[k]], range[from_back[k]]);
+                std::swap(indices[begin + moves[k]], indices[begin + from_back[k]]);
             }
             return left_count;
         }

@@ -14,6 +14,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -273,13 +274,13 @@ private:
             return {Vec3<Storage>(positions[face[0]]), Vec3<Storage>(positions[face[1]]), Vec3<Storage>(positions[face[2]])};
         };
         constexpr std::size_t grain = 16384;  // slots per task
-        if (order.size() < 2 * grain) {
+        if (order.size() < 2 * grain || tbb::this_task_arena::max_concurrency() == 1) {
             // Appended, not resized and assigned: resize would clear the whole array first.
             triangles_.reserve(order.size());
             for (const std::uint32_t i : order) triangles_.push_back(triangle(i));
         } else {
-            // Large meshes copy in parallel; the clearing this resize costs is less than the
-            // second thread saves.
+            // Large meshes copy in parallel where there is a second thread: the clearing this
+            // resize costs is less than that thread saves.
             triangles_.resize(order.size());
             tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), grain), [&](const tbb::blocked_range<std::size_t>& run) {
                 for (std::size_t slot = run.begin(); slot < run.end(); ++slot) triangles_[slot] = triangle(order[slot]);
