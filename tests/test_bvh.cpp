@@ -504,6 +504,23 @@ void check_structure(const prism::BvhTree<Real>& tree, const std::vector<prism::
     CHECK(contains(tree.bounds(), all));
 }
 
+// Whether two wide trees are the same, node for node and bit for bit: compared field by field,
+// since a node of double lanes has padding.
+template <class Tree>
+void check_same_wide_trees(const Tree& a, const Tree& b) {
+    REQUIRE(a.nodes().size() == b.nodes().size());
+    std::size_t different = 0;
+    for (std::size_t i = 0; i < a.nodes().size(); ++i) {
+        const auto &x = a.nodes()[i], &y = b.nodes()[i];
+        different += std::memcmp(x.bounds, y.bounds, sizeof x.bounds) != 0 || std::memcmp(x.child, y.child, sizeof x.child) != 0 ||
+                     std::memcmp(x.count, y.count, sizeof x.count) != 0;
+    }
+    CHECK(different == 0);
+    CHECK(a.primitive_indices() == b.primitive_indices());
+    const auto box_a = a.bounds(), box_b = b.bounds();
+    CHECK(std::memcmp(&box_a, &box_b, sizeof box_a) == 0);
+}
+
 template <class Real>
 std::vector<prism::Aabb<Real>> triangle_boxes(const std::vector<glm::dvec3>& positions,
                                               const std::vector<std::array<std::uint32_t, 3>>& triangles) {
@@ -698,16 +715,53 @@ TEST_CASE_TEMPLATE("BVH built from a box function: the same trees as from an arr
     const auto check_wide = [&]<int N>(std::integral_constant<int, N>) {
         const auto from_array = prism::WideBvhTree<Real, N>::build(boxes);
         const auto from_function = prism::WideBvhTree<Real, N>::build(std::uint32_t(boxes.size()), box_of);
-        REQUIRE(from_function.nodes().size() == from_array.nodes().size());
-        std::size_t different = 0;  // field by field: a node of double lanes has padding
-        for (std::size_t i = 0; i < from_array.nodes().size(); ++i) {
-            const auto &a = from_array.nodes()[i], &b = from_function.nodes()[i];
-            different += std::memcmp(a.bounds, b.bounds, sizeof a.bounds) != 0 || std::memcmp(a.child, b.child, sizeof a.child) != 0 ||
-                         std::memcmp(a.count, b.count, sizeof a.count) != 0;
+        check_same_wide_trees(from_array, from_function);
+    };
+    check_wide(std::integral_constant<int, 4>{});
+    check_wide(std::integral_constant<int, 8>{});
+}
+
+TEST_CASE_TEMPLATE("BVH built on two threads: the same trees as on one", Real, float, double) {
+    // Large nodes bin, partition and make their boxes in parallel runs merged in order, and the
+    // collapse plans subtrees as tasks: the trees must be the one-thread trees. 81,920
+    // triangles: the root and its children take the parallel passes (2 x 16,384 and more).
+    std::vector<glm::dvec3> positions;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    perturbed_sphere(6, 13, positions, triangles);
+    REQUIRE(triangles.size() >= 4 * 16384);
+    const auto boxes = triangle_boxes<Real>(positions, triangles);
+    const auto built_on = [&]<class Tree>(std::size_t threads, const Tree*) {
+        const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+        return Tree::build(boxes);
+    };
+    const auto same_box = [](const prism::Aabb<Real>& a, const prism::Aabb<Real>& b) {
+        return std::memcmp(&a, &b, sizeof a) == 0;  // bit for bit, the sign of a zero included
+    };
+    {
+        using Tree = prism::BvhTree<Real>;
+        const Tree one = built_on(1, (const Tree*)nullptr), two = built_on(2, (const Tree*)nullptr);
+        REQUIRE(one.nodes().size() == two.nodes().size());
+        CHECK(one.primitive_indices() == two.primitive_indices());
+        // Depth first: parallel tasks number the nodes in the order they run.
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> todo{{0, 0}};
+        std::size_t different = 0, visited = 0;
+        while (!todo.empty()) {
+            const auto [i, j] = todo.back();
+            todo.pop_back();
+            const auto &a = one.nodes()[i], &b = two.nodes()[j];
+            ++visited;
+            different += !same_box(a.bounds, b.bounds) || a.count != b.count || (a.is_leaf() && a.index != b.index);
+            if (!a.is_leaf() && !b.is_leaf()) {
+                todo.push_back({a.index, b.index});
+                todo.push_back({a.index + 1, b.index + 1});
+            }
         }
+        CHECK(visited == one.nodes().size());
         CHECK(different == 0);
-        CHECK(from_function.primitive_indices() == from_array.primitive_indices());
-        CHECK(same_box(from_function.bounds(), from_array.bounds()));
+    }
+    const auto check_wide = [&]<int N>(std::integral_constant<int, N>) {
+        using Tree = prism::WideBvhTree<Real, N>;
+        check_same_wide_trees(built_on(1, (const Tree*)nullptr), built_on(2, (const Tree*)nullptr));
     };
     check_wide(std::integral_constant<int, 4>{});
     check_wide(std::integral_constant<int, 8>{});

@@ -9,7 +9,9 @@
 #include <prism/memory/huge_page_allocator.hpp>
 #include <prism/simd/prefetch.hpp>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <array>
@@ -56,10 +58,11 @@ public:
         return build(static_cast<std::uint32_t>(boxes.size()), [boxes](std::uint32_t i) { return boxes[i]; }, options);
     }
 
-    // The same from `box_of(i)`, the box of primitive i, asked once per primitive in order: a
-    // caller that makes its boxes (a mesh from its triangles) hands them straight to the
-    // builder's own array instead of filling one of its own first (on the 766k-triangle dragon
-    // an 18 MB array written, faulted in and read back once).
+    // The same from `box_of(i)`, the box of primitive i, asked once per primitive: a caller
+    // that makes its boxes (a mesh from its triangles) hands them straight to the builder's own
+    // array instead of filling one of its own first (on the 766k-triangle dragon an 18 MB array
+    // written, faulted in and read back once). Below 2 setup_grain primitives it is asked in
+    // order on one thread; above, from every thread at once, in runs.
     template <class BoxOf>
         requires std::is_invocable_r_v<Aabb<Real>, const BoxOf&, std::uint32_t>
     static BvhTree build(std::uint32_t count, const BoxOf& box_of, const BvhBuildOptions& options = {}) {
@@ -71,13 +74,32 @@ public:
         // and come in huge pages: fresh memory's page faults in 4 kB pages were a tenth of the
         // dragon's build.
         HugePageVector<BuildBox> build_boxes(count);
-        Aabb<Real> root_bounds, centroid_bounds;
-        for (std::uint32_t i = 0; i < count; ++i) {
-            const Aabb<Real> box = box_of(i);
-            build_boxes[i] = BuildBox::of(box);
-            root_bounds.extend(box);
-            centroid_bounds.extend(box.centroid());
-        }
+        // The boxes are made in parallel, each task bounding its own run of primitives; the
+        // runs' bounds are joined in the runs' order. Aabb::extend keeps the earlier of two
+        // equal values (and never takes a NaN), so this finds the same bits, the sign of a zero
+        // included, as one loop from the first primitive to the last.
+        struct Bounds {
+            Aabb<Real> boxes, centroids;
+        };
+        const auto make_boxes = [&](const tbb::blocked_range<std::uint32_t>& run, Bounds bounds) {
+            for (std::uint32_t i = run.begin(); i < run.end(); ++i) {
+                const Aabb<Real> box = box_of(i);
+                build_boxes[i] = BuildBox::of(box);
+                bounds.boxes.extend(box);
+                bounds.centroids.extend(box.centroid());
+            }
+            return bounds;
+        };
+        const auto join = [](Bounds earlier, const Bounds& later) {
+            earlier.boxes.extend(later.boxes);
+            earlier.centroids.extend(later.centroids);
+            return earlier;
+        };
+        const Bounds bounds =
+            count >= 2 * setup_grain
+                ? tbb::parallel_reduce(tbb::blocked_range<std::uint32_t>(0, count, setup_grain), Bounds{}, make_boxes, join)
+                : make_boxes(tbb::blocked_range<std::uint32_t>(0, count), Bounds{});
+        const Aabb<Real> &root_bounds = bounds.boxes, &centroid_bounds = bounds.centroids;
         // A tree has at most 2 count - 1 nodes, but leaves of several primitives make far fewer.
         // The builder writes into storage of the bound left uninitialised, and only the nodes
         // made are copied out: the pages of the unused part are never touched (initialising
@@ -136,6 +158,9 @@ public:
 
 private:
     static constexpr Real far_scale = robust_far_scale<Real>;  // geometry/aabb.hpp
+    // Primitives per task where the builder's per-primitive passes run in parallel: below two
+    // of these, one thread (a task costs more than it saves).
+    static constexpr std::uint32_t setup_grain = 16384;
 
     static Real enter(const BvhNode<Real>& node, const RayBoxPrecomputed<Real>& ray, Real t_min, Real t_max) {
         return intersect_box(node.bounds, ray, t_min, t_max * far_scale, far_scale);

@@ -21,6 +21,8 @@
 #include <prism/simd/pack.hpp>
 #include <prism/simd/prefetch.hpp>
 
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -357,16 +359,31 @@ private:
         HugePageVector<std::uint8_t> as_leaf;  // the one-slot form is a leaf
         std::uint32_t leaf_limit = 0;
 
-        Range measure(std::uint32_t i) {
+        // measure and plan write only their own subtree's entries, so the two subtrees of a
+        // node near the root go to two tasks: the same tables, made on every thread there is.
+        // In trees of at least parallel_from primitives, nodes fewer than parallel_depth levels
+        // from the root fork (up to 2^parallel_depth tasks); smaller trees take one thread.
+        static constexpr int parallel_depth = 6;
+        static constexpr std::size_t parallel_from = 16384;
+        bool forks(int depth) const { return depth < parallel_depth && binary.primitive_indices().size() >= parallel_from; }
+
+        Range measure(std::uint32_t i, int depth = 0) {
             const BvhNode<Real>& node = binary.nodes()[i];
             if (node.is_leaf()) return ranges[i] = {node.index, node.index + node.count};
-            const Range left = measure(node.index), right = measure(node.index + 1);
+            Range left, right;
+            if (forks(depth)) {
+                tbb::parallel_invoke([&] { left = measure(node.index, depth + 1); },
+                                     [&] { right = measure(node.index + 1, depth + 1); });
+            } else {
+                left = measure(node.index, depth + 1);
+                right = measure(node.index + 1, depth + 1);
+            }
             return ranges[i] = {left.begin, right.end};
         }
 
         double& slots_cost(std::uint32_t i, int k) { return cost[std::size_t(i) * N + std::size_t(k - 1)]; }
 
-        void plan(std::uint32_t i) {
+        void plan(std::uint32_t i, int depth = 0) {
             const BvhNode<Real>& node = binary.nodes()[i];
             const double area = double(node.bounds.half_area());
             const std::uint32_t count = ranges[i].end - ranges[i].begin;
@@ -377,8 +394,12 @@ private:
                 return;
             }
             const std::uint32_t left = node.index, right = node.index + 1;
-            plan(left);
-            plan(right);
+            if (forks(depth)) {
+                tbb::parallel_invoke([&] { plan(left, depth + 1); }, [&] { plan(right, depth + 1); });
+            } else {
+                plan(left, depth + 1);
+                plan(right, depth + 1);
+            }
             // best[k]: the children's subtrees spread over k >= 2 slots.
             std::array<double, N + 1> best{};
             for (int k = 2; k <= N; ++k) {

@@ -12,6 +12,10 @@
 #include <prism/math/floating_point.hpp>
 #include <prism/scene/scene.hpp>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -274,16 +278,26 @@ private:
             index_ = Index::build(boxes);
         }
         // An index may repeat primitives to pad its leaves (the wide BVH): slots then outnumber
-        // triangles, and the repeats are copies that no leaf callback reports. Appended, not
-        // resized and assigned: resize would clear the whole array first.
+        // triangles, and the repeats are copies that no leaf callback reports.
         const auto& order = index_.primitive_indices();
-        triangles_.reserve(order.size());
-        for (const std::uint32_t i : order) {
+        const auto triangle = [&](std::uint32_t i) -> std::array<Vec3<Storage>, 3> {
             const std::size_t part = part_of(i);
             const auto& face = face_of(i, part);
             const auto& positions = parts[part]->positions;
-            triangles_.push_back({Vec3<Storage>(positions[face[0]]), Vec3<Storage>(positions[face[1]]),
-                                  Vec3<Storage>(positions[face[2]])});
+            return {Vec3<Storage>(positions[face[0]]), Vec3<Storage>(positions[face[1]]), Vec3<Storage>(positions[face[2]])};
+        };
+        constexpr std::size_t grain = 16384;  // slots per task
+        if (order.size() < 2 * grain || tbb::this_task_arena::max_concurrency() == 1) {
+            // Appended, not resized and assigned: resize would clear the whole array first.
+            triangles_.reserve(order.size());
+            for (const std::uint32_t i : order) triangles_.push_back(triangle(i));
+        } else {
+            // Large meshes copy in parallel where there is a second thread: the clearing this
+            // resize costs is less than that thread saves.
+            triangles_.resize(order.size());
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), grain), [&](const tbb::blocked_range<std::size_t>& run) {
+                for (std::size_t slot = run.begin(); slot < run.end(); ++slot) triangles_[slot] = triangle(order[slot]);
+            });
         }
         if constexpr (packed) packets_ = Packets(triangles_, order);
     }

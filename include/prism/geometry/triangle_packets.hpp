@@ -14,6 +14,9 @@
 #include <prism/simd/pack.hpp>
 #include <prism/simd/prefetch.hpp>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <array>
 #include <bit>
 #include <concepts>
@@ -74,14 +77,24 @@ public:
             (void)sources;
         }
         normals_.resize(triangles.size());
-        for (std::size_t slot = 0; slot < triangles.size(); ++slot) {
-            Packet& packet = packets_[slot / N];
-            const auto& p = triangles[slot];
-            for (int vertex = 0; vertex < 3; ++vertex)
-                for (int axis = 0; axis < 3; ++axis) packet.vertices[vertex][axis][slot % N] = p[vertex][axis];
-            // The back-face test's normal, rounded as TriangleMesh's scalar loop rounds it.
-            normals_[slot] = Vec3<Real>(glm::cross(p[1] - p[0], p[2] - p[0]));
-        }
+        // Each packet is written from its own slots only: large meshes fill theirs in parallel
+        // (a twentieth of the dragon's build on one thread).
+        const auto fill = [&](std::size_t first_packet, std::size_t end_packet) {
+            for (std::size_t slot = first_packet * N; slot < end_packet * N; ++slot) {
+                Packet& packet = packets_[slot / N];
+                const auto& p = triangles[slot];
+                for (int vertex = 0; vertex < 3; ++vertex)
+                    for (int axis = 0; axis < 3; ++axis) packet.vertices[vertex][axis][slot % N] = p[vertex][axis];
+                // The back-face test's normal, rounded as TriangleMesh's scalar loop rounds it.
+                normals_[slot] = Vec3<Real>(glm::cross(p[1] - p[0], p[2] - p[0]));
+            }
+        };
+        constexpr std::size_t grain = 2048;  // packets per task
+        if (packets_.size() < 2 * grain)
+            fill(0, packets_.size());
+        else
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, packets_.size(), grain),
+                              [&](const tbb::blocked_range<std::size_t>& run) { fill(run.begin(), run.end()); });
     }
 
     std::size_t memory_bytes() const {
