@@ -71,11 +71,6 @@ public:
     // `sources`, each slot's source number, kept where keeps_sources.
     TrianglePackets(const std::vector<std::array<Vec3<Storage>, 3>>& triangles, const std::vector<std::uint32_t>& sources) {
         packets_.resize(triangles.size() / N);
-        if constexpr (keeps_sources) {
-            for (std::size_t slot = 0; slot < triangles.size(); ++slot) packets_[slot / N].sources[slot % N] = sources[slot];
-        } else {
-            (void)sources;
-        }
         normals_.resize(triangles.size());
         // Each packet is written from its own slots only: large meshes fill theirs in parallel
         // (a twentieth of the dragon's build on one thread).
@@ -85,6 +80,7 @@ public:
                 const auto& p = triangles[slot];
                 for (int vertex = 0; vertex < 3; ++vertex)
                     for (int axis = 0; axis < 3; ++axis) packet.vertices[vertex][axis][slot % N] = p[vertex][axis];
+                if constexpr (keeps_sources) packet.sources[slot % N] = sources[slot];
                 // The back-face test's normal, rounded as TriangleMesh's scalar loop rounds it.
                 normals_[slot] = Vec3<Real>(glm::cross(p[1] - p[0], p[2] - p[0]));
             }
