@@ -10,11 +10,11 @@
 #include <prism/geometry/surface_error.hpp>
 #include <prism/geometry/triangle_packets.hpp>
 #include <prism/math/floating_point.hpp>
+#include <prism/memory/huge_page_allocator.hpp>
 #include <prism/scene/scene.hpp>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -286,19 +286,18 @@ private:
             const auto& positions = parts[part]->positions;
             return {Vec3<Storage>(positions[face[0]]), Vec3<Storage>(positions[face[1]]), Vec3<Storage>(positions[face[2]])};
         };
+        // Resized without clearing (a HugePageVector) and written slot by slot: large meshes
+        // copy theirs in parallel.
+        triangles_.resize(order.size());
+        const auto copy = [&](std::size_t first, std::size_t end) {
+            for (std::size_t slot = first; slot < end; ++slot) triangles_[slot] = triangle(order[slot]);
+        };
         constexpr std::size_t grain = 16384;  // slots per task
-        if (order.size() < 2 * grain || tbb::this_task_arena::max_concurrency() == 1) {
-            // Appended, not resized and assigned: resize would clear the whole array first.
-            triangles_.reserve(order.size());
-            for (const std::uint32_t i : order) triangles_.push_back(triangle(i));
-        } else {
-            // Large meshes copy in parallel where there is a second thread: the clearing this
-            // resize costs is less than that thread saves.
-            triangles_.resize(order.size());
-            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), grain), [&](const tbb::blocked_range<std::size_t>& run) {
-                for (std::size_t slot = run.begin(); slot < run.end(); ++slot) triangles_[slot] = triangle(order[slot]);
-            });
-        }
+        if (order.size() < 2 * grain)
+            copy(0, order.size());
+        else
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), grain),
+                              [&](const tbb::blocked_range<std::size_t>& run) { copy(run.begin(), run.end()); });
         if constexpr (packed) packets_ = Packets(triangles_, order);
     }
 
@@ -352,7 +351,7 @@ private:
     [[no_unique_address]] Packets packets_;
     // In slot order: the index's order, or the file's for a ShadingOnly mesh. A mesh over
     // several parts keeps no faces, and no triangles where its packets hold them.
-    std::vector<std::array<Vec3<Storage>, 3>> triangles_;
+    HugePageVector<std::array<Vec3<Storage>, 3>> triangles_;
     std::vector<std::array<std::uint32_t, 3>> faces_;  // vertex indices
     std::vector<Vec3<Real>> vertex_normals_;
     std::vector<Vec2<Real>> uvs_;

@@ -21,6 +21,7 @@
 #include <bit>
 #include <concepts>
 #include <cstdint>
+#include <span>
 #include <type_traits>
 #include <vector>
 
@@ -69,7 +70,7 @@ public:
 
     // `triangles` in slot order, a multiple of N of them (the wide BVH pads its leaves), and
     // `sources`, each slot's source number, kept where keeps_sources.
-    TrianglePackets(const std::vector<std::array<Vec3<Storage>, 3>>& triangles, const std::vector<std::uint32_t>& sources) {
+    TrianglePackets(std::span<const std::array<Vec3<Storage>, 3>> triangles, std::span<const std::uint32_t> sources) {
         packets_.resize(triangles.size() / N);
         normals_.resize(triangles.size());
         // Each packet is written from its own slots only: large meshes fill theirs in parallel
