@@ -11,10 +11,8 @@
 #include <prism/geometry/triangle_packets.hpp>
 #include <prism/math/floating_point.hpp>
 #include <prism/memory/huge_page_allocator.hpp>
+#include <prism/parallel/for_each_run.hpp>
 #include <prism/scene/scene.hpp>
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -293,11 +291,7 @@ private:
             for (std::size_t slot = first; slot < end; ++slot) triangles_[slot] = triangle(order[slot]);
         };
         constexpr std::size_t grain = 16384;  // slots per task
-        if (order.size() < 2 * grain)
-            copy(0, order.size());
-        else
-            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), grain),
-                              [&](const tbb::blocked_range<std::size_t>& run) { copy(run.begin(), run.end()); });
+        for_each_run(order.size(), grain, copy);
         if constexpr (packed) packets_ = Packets(triangles_, order);
     }
 

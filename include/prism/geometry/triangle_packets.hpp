@@ -11,11 +11,9 @@
 #include <prism/geometry/double_refine.hpp>
 #include <prism/geometry/hit.hpp>
 #include <prism/geometry/watertight.hpp>
+#include <prism/parallel/for_each_run.hpp>
 #include <prism/simd/pack.hpp>
 #include <prism/simd/prefetch.hpp>
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <array>
 #include <bit>
@@ -87,11 +85,7 @@ public:
             }
         };
         constexpr std::size_t grain = 2048;  // packets per task
-        if (packets_.size() < 2 * grain)
-            fill(0, packets_.size());
-        else
-            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, packets_.size(), grain),
-                              [&](const tbb::blocked_range<std::size_t>& run) { fill(run.begin(), run.end()); });
+        for_each_run(packets_.size(), grain, fill);
     }
 
     std::size_t memory_bytes() const {
