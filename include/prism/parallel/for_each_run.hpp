@@ -10,8 +10,9 @@
 namespace prism {
 
 // Calls run(first, end) on runs covering [0, count): one run on the calling thread below two
-// grains (a task costs more than it saves there), runs of at least `grain` on every thread above.
-// The runs are disjoint, so a run may write its own elements without a lock.
+// grains (a task costs more than it saves there); above, TBB's runs (it splits a run while it
+// holds more than `grain`) on every thread. The runs are disjoint, so a run may write its own
+// elements without a lock.
 template <class Run>
 void for_each_run(std::size_t count, std::size_t grain, const Run& run) {
     if (count < 2 * grain) {
