@@ -29,89 +29,20 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <limits>
 #include <span>
 #include <type_traits>
 #include <vector>
 
 namespace prism {
 
-// The child boxes are quantised (Ylitie, Karras, Laine 2017; Embree's QBVH8): per axis the node
-// keeps an origin and a power-of-two scale, and each child's plane is the byte q of
-// origin + q * scale, rounded outward. Eight 4-byte planes per row become eight bytes: an 8-wide
-// float node is two cache lines instead of four, a double node three instead of eight.
-// q * scale is exact (q has 8 bits, the scale is a normal power of two), so a plane is one
-// rounding of the sum, the same in the build's scalar code and the traversal's SIMD code, and the
-// build checks every plane with that very arithmetic and steps q until the plane is outside the
-// true one: a dequantised box holds its child's box, so every ray that enters the exact box
-// enters it (the slab test and Ize's scaling are unchanged; only the planes moved out).
 template <Scalar Real, int N>
 struct alignas(64) WideBvhNode {
-    Real origin[3];
-    // A power of two, or +inf for an axis no normal scale spans (a non-finite or vast box): its
-    // planes are then 0 * inf = NaN, which the slab test skips, so that axis constrains nothing.
-    Real scale[3];
-    // planes[axis][child] is the low plane, planes[3 + axis][child] the high one.
-    std::uint8_t planes[6][N];
+    // bounds[axis][child] is the low plane, bounds[3 + axis][child] the high one. An empty
+    // child slot is the empty box (low +inf, high -inf): entered at +inf and left at -inf
+    // whatever the direction's sign, it is missed even by a ray with t_max = inf.
+    Real bounds[6][N];
     std::uint32_t child[N];  // inner child: node index; leaf: first slot in primitive_indices
-    std::uint8_t count[N];   // leaf: primitive count (at most 2N); 0: inner child (or empty slot)
-    std::uint8_t occupied;   // bit i: slot i holds a child; the traversal masks the others out
-
-    static Real dequantise(std::uint8_t q, Real origin, Real scale) { return Real(q) * scale + origin; }
-
-    // Slot i's box as the traversal sees it (it holds the child's true box).
-    Aabb<Real> box(int slot) const {
-        Aabb<Real> result;
-        for (int axis = 0; axis < 3; ++axis) {
-            result.min[axis] = dequantise(planes[axis][slot], origin[axis], scale[axis]);
-            result.max[axis] = dequantise(planes[3 + axis][slot], origin[axis], scale[axis]);
-        }
-        return result;
-    }
-
-    // Quantises boxes[0..size) into slots 0..size), outward; the other slots are empty.
-    void set_boxes(std::span<const Aabb<Real>> boxes) {
-        using Wide = long double;  // holds every difference of two Reals' planes, divided by a power of two
-        constexpr int min_exponent = std::numeric_limits<Real>::min_exponent - 1;  // the least normal
-        constexpr int max_exponent = std::numeric_limits<Real>::max_exponent - 9;  // 255 * 2^e finite
-        occupied = std::uint8_t((1u << boxes.size()) - 1);
-        for (int row = 0; row < 6; ++row)
-            for (std::uint8_t& q : planes[row]) q = 0;
-        for (int axis = 0; axis < 3; ++axis) {
-            Real low = infinity<Real>, high = -infinity<Real>;
-            for (const Aabb<Real>& b : boxes) {
-                low = std::min(low, b.min[axis]);
-                high = std::max(high, b.max[axis]);
-            }
-            origin[axis] = low;
-            scale[axis] = infinity<Real>;
-            if (boxes.empty() || !std::isfinite(low) || !std::isfinite(high)) {
-                origin[axis] = 0;  // NaN planes: unconstrained
-                continue;
-            }
-            // The least power of two whose 255 steps from the origin reach the high plane,
-            // found by the arithmetic the traversal uses (the sum rounds).
-            int exponent = std::max(min_exponent, std::ilogb(std::max(Wide(high) - Wide(low), std::numeric_limits<Wide>::min())) - 8);
-            while (exponent <= max_exponent && dequantise(255, low, std::ldexp(Real(1), exponent)) < high) ++exponent;
-            if (exponent > max_exponent) {
-                origin[axis] = 0;
-                continue;
-            }
-            const Real step = std::ldexp(Real(1), exponent);
-            scale[axis] = step;
-            for (std::size_t c = 0; c < boxes.size(); ++c) {
-                // dequantise(0) is the origin, at or below every low plane; 255 reaches the high.
-                long double estimate = std::floor((Wide(boxes[c].min[axis]) - Wide(low)) / Wide(step));
-                int q = int(std::clamp<Wide>(estimate, 0, 255));
-                while (q > 0 && dequantise(std::uint8_t(q), low, step) > boxes[c].min[axis]) --q;
-                planes[axis][c] = std::uint8_t(q);
-                estimate = std::ceil((Wide(boxes[c].max[axis]) - Wide(low)) / Wide(step));
-                q = int(std::clamp<Wide>(estimate, 0, 255));
-                while (q < 255 && dequantise(std::uint8_t(q), low, step) < boxes[c].max[axis]) ++q;
-                planes[3 + axis][c] = std::uint8_t(q);
-            }
-        }
-    }
+    std::uint32_t count[N];  // leaf: primitive count; 0: inner child (or empty slot)
 };
 
 template <Scalar Real, int N>
@@ -159,7 +90,6 @@ public:
             // One leaf: a root with a single child keeps traversal uniform.
             const std::uint32_t root = tree.new_node();
             collapser.fill_child(root, 0, 0);
-            tree.nodes_[root].set_boxes(std::span(&binary.nodes()[0].bounds, 1));
         } else {
             collapser.collapse(0);
         }
@@ -185,7 +115,7 @@ public:
     // the world's space prepares it once per ray for both levels (geometry/scene_geometry.hpp).
     struct TraversalRay {
         Pack origin[3], inverse_direction[3];
-        // Where the entered and the left plane of each axis start in WideBvhNode::planes, by
+        // Where the entered and the left plane of each axis start in WideBvhNode::bounds, by
         // the direction's sign: row times N, an offset the loads add without a multiply.
         std::ptrdiff_t near_plane[3], far_plane[3];
 
@@ -239,7 +169,7 @@ public:
     [[gnu::always_inline]] bool enters(const TraversalRay& ray, Real t_min, Real t_max) const {
         if (nodes_.empty()) return false;
         Pack entry;
-        return entered(nodes_[0], ray, t_min, t_max, entry) != 0;
+        return enter(nodes_[0], ray, t_min, t_max, entry).any();
     }
 
 private:
@@ -249,16 +179,12 @@ private:
     // as in the scalar intersect_box.
     [[gnu::always_inline]] static simd::Mask<Real, N> enter(const WideBvhNode<Real, N>& node, const TraversalRay& ray, Real t_min, Real t_max,
                                      Pack& entry) {
-        const std::uint8_t* planes = &node.planes[0][0];
+        const Real* planes = &node.bounds[0][0];
         Pack t_enter = Pack::broadcast(t_min);
         Pack t_exit = Pack::broadcast(t_max);
         for (int axis = 0; axis < 3; ++axis) {
-            // WideBvhNode::dequantise, lane by lane (fused: the product is exact, so the same).
-            const Pack scale = Pack::broadcast(node.scale[axis]), origin = Pack::broadcast(node.origin[axis]);
-            const Pack near = simd::fused_multiply_add(Pack::load_bytes(planes + ray.near_plane[axis]), scale, origin);
-            const Pack far = simd::fused_multiply_add(Pack::load_bytes(planes + ray.far_plane[axis]), scale, origin);
-            const Pack t_near = (near - ray.origin[axis]) * ray.inverse_direction[axis];
-            const Pack t_far = (far - ray.origin[axis]) * ray.inverse_direction[axis];
+            const Pack t_near = (Pack::load(planes + ray.near_plane[axis]) - ray.origin[axis]) * ray.inverse_direction[axis];
+            const Pack t_far = (Pack::load(planes + ray.far_plane[axis]) - ray.origin[axis]) * ray.inverse_direction[axis];
             t_enter = simd::max_keep(t_near, t_enter);
             t_exit = simd::min_keep(t_far, t_exit);
         }
@@ -268,12 +194,6 @@ private:
         t_exit = t_exit * Pack::broadcast(far_scale);
         entry = t_enter;
         return t_enter <= t_exit;
-    }
-
-    // The children entered within [t_min, t_max], lane i as bit i; the empty slots are masked out.
-    [[gnu::always_inline]] static std::uint32_t entered(const WideBvhNode<Real, N>& node, const TraversalRay& ray, Real t_min,
-                                                        Real t_max, Pack& entry) {
-        return enter(node, ray, t_min, t_max, entry).bits() & node.occupied;
     }
 
     struct StackEntry {
@@ -308,7 +228,7 @@ private:
             const WideBvhNode<Real, N>& node = nodes_[current];
             simd::prefetch(node);
             Pack entry_distances;
-            std::uint32_t hits = entered(node, slabs, t_min, t_max, entry_distances);
+            std::uint32_t hits = enter(node, slabs, t_min, t_max, entry_distances).bits();
             bool descend = false;
             if (hits != 0 && (hits & (hits - 1)) == 0) {
                 // One child entered, the common case deep in the tree: no stack, no sort.
@@ -413,7 +333,8 @@ private:
 
     std::uint32_t new_node() {
         WideBvhNode<Real, N> node;
-        node.set_boxes({});
+        for (int row = 0; row < 6; ++row)
+            for (Real& plane : node.bounds[row]) plane = row < 3 ? infinity<Real> : -infinity<Real>;
         for (int i = 0; i < N; ++i) node.child[i] = node.count[i] = 0;
         nodes_.push_back(node);
         return std::uint32_t(nodes_.size() - 1);
@@ -526,22 +447,22 @@ private:
             gather(binary.nodes()[i].index, j, children, child_count);
             gather(binary.nodes()[i].index + 1, N - j, children, child_count);
             const std::uint32_t wide = tree.new_node();
-            std::array<Aabb<Real>, N> boxes;
-            for (int c = 0; c < child_count; ++c) {
-                boxes[c] = binary.nodes()[children[c]].bounds;
-                fill_child(wide, c, children[c]);
-            }
-            tree.nodes_[wide].set_boxes(std::span(boxes.data(), std::size_t(child_count)));
+            for (int c = 0; c < child_count; ++c) fill_child(wide, c, children[c]);
             return wide;
         }
 
         void fill_child(std::uint32_t wide, int slot, std::uint32_t i) {
+            const Aabb<Real>& box = binary.nodes()[i].bounds;
+            for (int axis = 0; axis < 3; ++axis) {
+                tree.nodes_[wide].bounds[axis][slot] = box.min[axis];
+                tree.nodes_[wide].bounds[3 + axis][slot] = box.max[axis];
+            }
             if (becomes_leaf(i)) {
                 auto& indices = tree.primitive_indices_;
                 const auto& binary_indices = binary.primitive_indices();
                 const Range range = ranges[i];
                 tree.nodes_[wide].child[slot] = std::uint32_t(indices.size());
-                tree.nodes_[wide].count[slot] = std::uint8_t(range.end - range.begin);
+                tree.nodes_[wide].count[slot] = range.end - range.begin;
                 indices.insert(indices.end(), binary_indices.begin() + range.begin, binary_indices.begin() + range.end);
                 while (indices.size() % N != 0) indices.push_back(indices.back());
             } else {

@@ -11,13 +11,7 @@
 #pragma once
 
 #include <array>
-#include <cmath>
 #include <cstdint>
-#include <type_traits>
-
-#if defined(__FMA__) && (defined(__x86_64__) || defined(__i386__))
-#include <immintrin.h>
-#endif
 
 #if !defined(PRISM_SIMD_SCALAR) && defined(__GLIBCXX__) && __has_include(<experimental/simd>)
 #include <experimental/simd>
@@ -58,13 +52,6 @@ struct Pack {
 
     PRISM_SIMD_INLINE static Pack broadcast(T value) { return {Native(value)}; }
     PRISM_SIMD_INLINE static Pack load(const T* values) { return {Native(values, stdx::element_aligned)}; }
-    // N unsigned bytes, each converted exactly to T (a quantised plane, accel/wide_bvh_tree.hpp):
-    // through a byte simd, GCC emits one widening load and one conversion (vpmovzxbd, vcvtdq2ps),
-    // where a lane-by-lane generator converted each byte on its own.
-    PRISM_SIMD_INLINE static Pack load_bytes(const std::uint8_t* bytes) {
-        const stdx::simd<std::uint8_t, stdx::simd_abi::deduce_t<std::uint8_t, N>> narrow(bytes, stdx::element_aligned);
-        return {stdx::static_simd_cast<Native>(narrow)};
-    }
     PRISM_SIMD_INLINE void store(T* values) const { native.copy_to(values, stdx::element_aligned); }
 
     PRISM_SIMD_INLINE friend Pack operator+(Pack a, Pack b) { return {a.native + b.native}; }
@@ -124,11 +111,6 @@ struct Pack {
         for (int i = 0; i < N; ++i) result.lanes[i] = values[i];
         return result;
     }
-    PRISM_SIMD_INLINE static Pack load_bytes(const std::uint8_t* bytes) {
-        Pack result;
-        for (int i = 0; i < N; ++i) result.lanes[i] = T(bytes[i]);
-        return result;
-    }
     PRISM_SIMD_INLINE void store(T* values) const {
         for (int i = 0; i < N; ++i) values[i] = lanes[i];
     }
@@ -165,32 +147,6 @@ private:
 
 // a > b ? a : b and a < b ? a : b, lane by lane: a NaN in `a` leaves `b`, which is what the
 // slab test needs (a NaN slab distance, 0 * inf on a slab plane, constrains nothing).
-// a * b + c rounded once, lane by lane. Where the product is exact (a quantised plane: a byte
-// times a power of two) it equals a * b + c in two operations, bit for bit, in one instruction
-// and one latency instead of two; prism's -ffp-contract=off forbids the compiler to fuse them.
-template <class T, int N>
-PRISM_SIMD_INLINE inline Pack<T, N> fused_multiply_add(Pack<T, N> a, Pack<T, N> b, Pack<T, N> c) {
-#if defined(PRISM_SIMD_STDX) && defined(__FMA__)
-    using Native = typename Pack<T, N>::Native;
-    if constexpr (std::is_same_v<T, float> && requires(Native x) { static_cast<__m256>(x); })
-        return {Native(_mm256_fmadd_ps(static_cast<__m256>(a.native), static_cast<__m256>(b.native), static_cast<__m256>(c.native)))};
-    else if constexpr (std::is_same_v<T, double> && requires(Native x) { static_cast<__m256d>(x); })
-        return {Native(_mm256_fmadd_pd(static_cast<__m256d>(a.native), static_cast<__m256d>(b.native), static_cast<__m256d>(c.native)))};
-#if defined(__AVX512F__)
-    else if constexpr (std::is_same_v<T, float> && requires(Native x) { static_cast<__m512>(x); })
-        return {Native(_mm512_fmadd_ps(static_cast<__m512>(a.native), static_cast<__m512>(b.native), static_cast<__m512>(c.native)))};
-    else if constexpr (std::is_same_v<T, double> && requires(Native x) { static_cast<__m512d>(x); })
-        return {Native(_mm512_fmadd_pd(static_cast<__m512d>(a.native), static_cast<__m512d>(b.native), static_cast<__m512d>(c.native)))};
-#endif
-#endif
-    alignas(64) T x[N], y[N], z[N];
-    a.store(x);
-    b.store(y);
-    c.store(z);
-    for (int i = 0; i < N; ++i) x[i] = std::fma(x[i], y[i], z[i]);
-    return Pack<T, N>::load(x);
-}
-
 template <class T, int N>
 PRISM_SIMD_INLINE inline Pack<T, N> max_keep(Pack<T, N> a, Pack<T, N> b) { return select(a > b, a, b); }
 template <class T, int N>
