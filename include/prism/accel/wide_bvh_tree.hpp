@@ -120,25 +120,15 @@ public:
         std::ptrdiff_t near_plane[3], far_plane[3];
 
         explicit TraversalRay(const Ray<Real>& ray) {
-            // The three reciprocals in one 4-lane division, each lane RayBoxPrecomputed's 1 / d
-            // bit for bit; the lanes are gathered in registers (a vector loaded from scalar
-            // stores waits for a failed store forwarding).
-            using Four = simd::Pack<Real, 4>;
-            const Real x = ray.direction.x, y = ray.direction.y, z = ray.direction.z;
-            const Four directions{typename Four::Native([&](auto i) { return i == 0 ? x : i == 1 ? y : i == 2 ? z : Real(1); })};
-            const Four reciprocals = Four::broadcast(Real(1)) / directions;
+            const RayBoxPrecomputed<Real> box_ray(ray);
             for (int axis = 0; axis < 3; ++axis) {
-                const Real inverse = reciprocals.native[axis];
-                origin[axis] = Pack::broadcast(ray.origin[axis]);
-                inverse_direction[axis] = Pack::broadcast(inverse);
+                origin[axis] = Pack::broadcast(box_ray.origin[axis]);
+                inverse_direction[axis] = Pack::broadcast(box_ray.inverse_direction[axis]);
                 // The sign decides which plane is entered, so no per-child min/max: the same
                 // order the scalar test's swap finds (1/-0 = -inf enters by the high plane).
-                const bool negative = std::signbit(inverse);
-                // Arithmetic, not a choice: GCC had made the choice a branch, which diffuse rays'
-                // random signs mispredict.
-                const std::ptrdiff_t flip = std::ptrdiff_t(negative) * 3;
-                near_plane[axis] = (axis + flip) * N;
-                far_plane[axis] = (axis + 3 - flip) * N;
+                const bool negative = std::signbit(box_ray.inverse_direction[axis]);
+                near_plane[axis] = (negative ? 3 + axis : axis) * N;
+                far_plane[axis] = (negative ? axis : 3 + axis) * N;
             }
         }
     };
