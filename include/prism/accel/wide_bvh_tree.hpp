@@ -196,17 +196,10 @@ private:
         return t_enter <= t_exit;
     }
 
-    // Eight bytes in a float tree: the child word and the count in one word (the count, at
-    // most 2N, in the top five bits), and the entry distance.
     struct StackEntry {
-        static constexpr int count_shift = 27;
-        std::uint32_t word;
-        Real distance;  // where the ray enters its box
-        [[gnu::always_inline]] StackEntry(std::uint32_t child, std::uint32_t count, Real entry)
-            : word(child | count << count_shift), distance(entry) {}
-        StackEntry() = default;
-        [[gnu::always_inline]] std::uint32_t child() const { return word & ((std::uint32_t(1) << count_shift) - 1); }
-        [[gnu::always_inline]] std::uint32_t count() const { return word >> count_shift; }  // 0: an inner node
+        std::uint32_t child;
+        std::uint32_t count;  // 0: an inner node
+        Real distance;        // where the ray enters its box
     };
 
     struct NoTouch {
@@ -217,10 +210,10 @@ private:
     // now (the node, or through `touch` the leaf's primitives) so that the wait overlaps them.
     template <class Touch>
     [[gnu::always_inline]] void prefetch(const StackEntry& entry, Touch& touch) const {
-        if (entry.count() == 0)
-            simd::prefetch(nodes_[entry.child()]);
+        if (entry.count == 0)
+            simd::prefetch(nodes_[entry.child]);
         else
-            touch(entry.child());
+            touch(entry.child);
     }
 
     template <bool AnyHit, class Leaf, class Touch = NoTouch>
@@ -324,12 +317,12 @@ private:
                 if constexpr (!AnyHit) {
                     if (entry.distance > t_max * far_scale) continue;
                 }
-                if (entry.count() == 0) {
-                    current = entry.child();
+                if (entry.count == 0) {
+                    current = entry.child;
                     descend = true;
                     break;
                 }
-                if (leaf(entry.child(), entry.count(), t_max)) {
+                if (leaf(entry.child, entry.count, t_max)) {
                     found = true;
                     if constexpr (AnyHit) return true;
                 }
