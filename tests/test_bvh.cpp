@@ -1048,20 +1048,14 @@ TEST_CASE_TEMPLATE("SceneGeometry: the course's culling keeps smooth meshes and 
 
 namespace {
 
-// Every primitive in exactly one leaf; a leaf of more than N/2 primitives starting at a multiple
-// of N below half_leaves_begin() and padded to a multiple of N, one of at most N/2 starting at a
-// multiple of N/2 from it on and padded to N/2, with repeats of its last primitive; the padded
-// leaves covering every slot once; children inside their parent, leaves around their
+// Every primitive in exactly one leaf, each leaf's range starting at a multiple of N and padded
+// with repeats of its last primitive, children inside their parent, leaves around their
 // primitives, every node reached once, empty child slots missed by every ray.
 template <class Real, int N>
 void check_wide_structure(const prism::WideBvhTree<Real, N>& tree, const std::vector<prism::Aabb<Real>>& boxes) {
     const auto& nodes = tree.nodes();
     const auto& order = tree.primitive_indices();
-    const std::uint32_t half_begin = tree.half_leaves_begin();
-    CHECK(half_begin % N == 0);
-    CHECK(half_begin <= order.size());
-    CHECK((order.size() - half_begin) % (N / 2) == 0);
-    std::vector<int> covered(order.size(), 0);
+    CHECK(order.size() % N == 0);
     if (boxes.empty()) {
         CHECK(nodes.empty());
         return;
@@ -1091,17 +1085,13 @@ void check_wide_structure(const prism::WideBvhTree<Real, N>& tree, const std::ve
                 continue;
             }
             const std::uint32_t first = node.child[c], count = node.count[c];
-            const bool half = count <= std::uint32_t(N / 2);
-            const std::uint32_t step = half ? N / 2 : N;
-            if (first % step != 0 || half != (first >= half_begin)) ++misaligned;
-            const std::uint32_t padded_end = (first + count + step - 1) / step * step;
-            REQUIRE(padded_end <= (half ? order.size() : half_begin));
+            if (first % N != 0) ++misaligned;
+            REQUIRE(first + count <= order.size());
             for (std::uint32_t slot = first; slot < first + count; ++slot) {
                 ++listed[order[slot]];
                 if (!contains(box, boxes[order[slot]])) ++primitive_outside;
             }
-            for (std::uint32_t slot = first; slot < padded_end; ++slot) ++covered[slot];
-            for (std::uint32_t slot = first + count; slot < padded_end; ++slot)
+            for (std::uint32_t slot = first + count; slot % N != 0; ++slot)
                 if (order[slot] != order[first + count - 1]) ++bad_padding;
         }
     }
@@ -1109,7 +1099,6 @@ void check_wide_structure(const prism::WideBvhTree<Real, N>& tree, const std::ve
     CHECK(std::count(node_visits.begin(), node_visits.end(), 1) == std::ptrdiff_t(nodes.size()));
     CHECK(misaligned == 0);
     CHECK(bad_padding == 0);
-    CHECK(std::count(covered.begin(), covered.end(), 1) == std::ptrdiff_t(order.size()));
     CHECK(primitive_outside == 0);
     CHECK(child_outside == 0);
     // The empty slots are missed, even by rays of unbounded length along and against each axis.

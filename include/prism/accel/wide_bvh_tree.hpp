@@ -10,14 +10,10 @@
 // holds no primitives: a leaf hands its range of primitive_indices to a callback.
 //
 // Leaves are sized for N-wide triangle packets: a leaf is a binary subtree of at most 2N
-// primitives (one or two packets; max_leaf_size when that is below N). A leaf of more than N/2
-// primitives starts at a multiple of N and is padded up to the next multiple of N with repeats
-// of its last primitive; a leaf of at most N/2 (about a third of a course mesh's lanes were
-// such leaves' padding) is padded to N/2 only, and these small leaves come after all the
-// others, from half_leaves_begin() (a multiple of N) on. So a slot alone says which packet
-// holds it, without a search or a table: packet k of a mesh is slots [k N, k N + N) below
-// half_leaves_begin() and half packet k slots [h + k N/2, h + (k + 1) N/2) from h on
-// (geometry/triangle_packets.hpp). A leaf callback still gets the true count.
+// primitives (one or two packets; max_leaf_size when that is below N), and every leaf's range
+// starts at a multiple of N, padded up to the next multiple of N with repeats of its last
+// primitive. A leaf callback still gets the true count; the padding only lets packet k of a
+// mesh be slots [k N, k N + N) (geometry/triangle_packets.hpp).
 #pragma once
 
 #include <prism/accel/bvh_tree.hpp>
@@ -80,7 +76,7 @@ public:
         WideBvhTree tree;
         if (count == 0) return tree;
         tree.bounds_ = binary.bounds();
-        Collapser collapser{binary, tree, options.max_leaf_size, {}, {}, {}, {}, 0, {}, {}};
+        Collapser collapser{binary, tree, options.max_leaf_size, {}, {}, {}, {}};
         collapser.ranges.resize(binary.nodes().size());
         collapser.measure(0);
         collapser.cost.resize(binary.nodes().size() * N);
@@ -97,16 +93,13 @@ public:
         } else {
             collapser.collapse(0);
         }
-        collapser.place_half_leaves();
         tree.primitive_indices_.shrink_to_fit();
         return tree;
     }
 
     const std::vector<WideBvhNode<Real, N>>& nodes() const { return nodes_; }
-    // Leaf ranges padded to multiples of N, or of N/2 from half_leaves_begin() on (see the top
-    // of this file).
+    // Leaf ranges padded to multiples of N (see the top of this file).
     const std::vector<std::uint32_t>& primitive_indices() const { return primitive_indices_; }
-    std::uint32_t half_leaves_begin() const { return half_leaves_begin_; }
     Aabb<Real> bounds() const { return bounds_; }
     std::size_t memory_bytes() const {
         return nodes_.capacity() * sizeof(WideBvhNode<Real, N>) + primitive_indices_.capacity() * sizeof(std::uint32_t);
@@ -465,44 +458,23 @@ private:
                 tree.nodes_[wide].bounds[3 + axis][slot] = box.max[axis];
             }
             if (becomes_leaf(i)) {
+                auto& indices = tree.primitive_indices_;
                 const auto& binary_indices = binary.primitive_indices();
                 const Range range = ranges[i];
-                const std::uint32_t count = range.end - range.begin;
-                const bool half = count <= std::uint32_t(N / 2);
-                auto& indices = half ? half_indices : tree.primitive_indices_;
-                // A small leaf's first slot is relative to the half leaves until they are placed.
-                if (half) half_children.push_back({wide, slot});
                 tree.nodes_[wide].child[slot] = std::uint32_t(indices.size());
-                tree.nodes_[wide].count[slot] = count;
+                tree.nodes_[wide].count[slot] = range.end - range.begin;
                 indices.insert(indices.end(), binary_indices.begin() + range.begin, binary_indices.begin() + range.end);
-                while (indices.size() % (half ? N / 2 : N) != 0) indices.push_back(indices.back());
+                while (indices.size() % N != 0) indices.push_back(indices.back());
             } else {
                 const std::uint32_t node = collapse(i);  // may reallocate nodes_: index again
                 tree.nodes_[wide].child[slot] = node;
                 tree.nodes_[wide].count[slot] = 0;
             }
         }
-
-        // The small leaves after the others (see the top of this file), in the order they were
-        // made, so nearby small leaves stay nearby in memory.
-        std::vector<std::uint32_t> half_indices;
-        struct ChildSlot {
-            std::uint32_t node;
-            int slot;
-        };
-        std::vector<ChildSlot> half_children;
-        void place_half_leaves() {
-            auto& indices = tree.primitive_indices_;
-            const auto begin = std::uint32_t(indices.size());
-            for (const ChildSlot& child : half_children) tree.nodes_[child.node].child[child.slot] += begin;
-            indices.insert(indices.end(), half_indices.begin(), half_indices.end());
-            tree.half_leaves_begin_ = begin;
-        }
     };
 
     std::vector<WideBvhNode<Real, N>> nodes_;
     std::vector<std::uint32_t> primitive_indices_;
-    std::uint32_t half_leaves_begin_ = 0;
     Aabb<Real> bounds_;
 };
 

@@ -292,7 +292,7 @@ private:
         };
         constexpr std::size_t grain = 16384;  // slots per task
         for_each_run(order.size(), grain, copy);
-        if constexpr (packed) packets_ = Packets(triangles_, order, index_.half_leaves_begin());
+        if constexpr (packed) packets_ = Packets(triangles_, order);
     }
 
     static Aabb<Real> triangle_box(const scene::Mesh& mesh, const std::array<std::uint32_t, 3>& face) {

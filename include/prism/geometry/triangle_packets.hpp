@@ -34,107 +34,92 @@ class TrianglePackets {
 public:
     using Storage = typename Intersector::template Storage<Real>;
     using Prepared = typename Intersector::template Prepared<Real>;
-    // A leaf of at most `half` triangles is one half-width packet, tested with half-width
-    // instructions (float: an xmm register where N = 8; double: a ymm one): about a third of a
-    // course mesh's lanes had been padding in full packets, and a double leaf test is bound by
-    // its arithmetic (bench/RESULTS.md, "double2"), which a 4-lane division halves.
-    static constexpr int half = N / 2;
-    template <int W> using PackOf = simd::Pack<Storage, W>;
+    using Pack = simd::Pack<Storage, N>;
 
-    // What the packed test needs of a ray, broadcast once per ray: for both widths, each its
-    // own broadcasts (a ray takes both kinds of leaves).
-    template <int W>
-    struct RayLanes {
-        PackOf<W> origin[3];
-        PackOf<W> sx, sy, sz;
-        explicit RayLanes(const Watertight::Prepared<Storage>& ray) {
-            for (int axis = 0; axis < 3; ++axis) origin[axis] = PackOf<W>::broadcast(ray.origin[axis]);
-            sx = PackOf<W>::broadcast(ray.sx);
-            sy = PackOf<W>::broadcast(ray.sy);
-            sz = PackOf<W>::broadcast(ray.sz);
-        }
-    };
+    // What the packed test needs of a ray, broadcast once per ray.
     struct PackedRay {
         int kx, ky, kz;
-        RayLanes<N> full;
-        RayLanes<half> halved;
-        explicit PackedRay(const Prepared& prepared)
-            : kx(watertight_ray(prepared).kx), ky(watertight_ray(prepared).ky), kz(watertight_ray(prepared).kz),
-              full(watertight_ray(prepared)), halved(watertight_ray(prepared)) {}
+        Pack origin[3];
+        Pack sx, sy, sz;
+        explicit PackedRay(const Prepared& prepared) {
+            const Watertight::Prepared<Storage>& ray = watertight_ray(prepared);
+            kx = ray.kx;
+            ky = ray.ky;
+            kz = ray.kz;
+            for (int axis = 0; axis < 3; ++axis) origin[axis] = Pack::broadcast(ray.origin[axis]);
+            sx = Pack::broadcast(ray.sx);
+            sy = Pack::broadcast(ray.sy);
+            sz = Pack::broadcast(ray.sz);
+        }
     };
 
     TrianglePackets() = default;
 
-    // A packet of W lanes: the vertices SoA, and where keeps_sources, the slots' source numbers
-    // (TriangleMesh::source_triangle) in bytes the vertices leave unused: float: 288 bytes of
-    // vertices in a 320-byte full packet, 144 in a 160-byte half one; so the numbers cost no
-    // memory and sit on a line the test has just read. A merged index looks its hit's number up
-    // after the traversal, and the separate array's load missed the cache: a fifth of
-    // SceneGeometry::intersect's samples on the course's diffuse rays. Half packets are aligned
-    // to 32 bytes, not a cache line: rows of at most 32 bytes at 32-byte steps never straddle a
-    // line, and a 160- or 288-byte packet spans as many lines either way, so the 32 bytes a
-    // line's alignment would add are saved.
-    template <int W>
-    static constexpr std::size_t alignment = W == N ? simd::cache_line_bytes : 32;
-    template <int W>
-    static constexpr std::size_t vertex_bytes = 9 * W * sizeof(Storage);
-    template <int W>
-    static constexpr bool sources_fit = vertex_bytes<W> % alignment<W> != 0 &&
-                                        alignment<W> - vertex_bytes<W> % alignment<W> >= W * sizeof(std::uint32_t);
-    // Both kinds hold them or neither does, so that source() needs no other array.
-    static constexpr bool keeps_sources = sources_fit<N> && sources_fit<half>;
+    // Whether a packet also holds its slots' source numbers (TriangleMesh::source_triangle):
+    // where its vertices leave at least that much of their last cache line unused (float: 288
+    // bytes of vertices in a 320-byte packet), so the numbers cost no memory and sit on a line
+    // the test has just read. A merged index looks its hit's number up after the traversal,
+    // and the separate array's load missed the cache: a fifth of SceneGeometry::intersect's
+    // samples on the course's diffuse rays.
+    static constexpr std::size_t vertex_bytes = 9 * N * sizeof(Storage);
+    static constexpr bool keeps_sources =
+        vertex_bytes % simd::cache_line_bytes != 0 &&
+        simd::cache_line_bytes - vertex_bytes % simd::cache_line_bytes >= N * sizeof(std::uint32_t);
 
-    // `triangles` in slot order (the wide BVH's: leaves padded to N slots below `half_begin`,
-    // to N/2 from it on; accel/wide_bvh_tree.hpp), and `sources`, each slot's source number,
-    // kept where keeps_sources.
-    TrianglePackets(std::span<const std::array<Vec3<Storage>, 3>> triangles, std::span<const std::uint32_t> sources,
-                    std::uint32_t half_begin)
-        : half_begin_(half_begin) {
-        packets_.resize(half_begin / N);
-        halves_.resize((triangles.size() - half_begin) / half);
+    // `triangles` in slot order, a multiple of N of them (the wide BVH pads its leaves), and
+    // `sources`, each slot's source number, kept where keeps_sources.
+    TrianglePackets(std::span<const std::array<Vec3<Storage>, 3>> triangles, std::span<const std::uint32_t> sources) {
+        packets_.resize(triangles.size() / N);
         normals_.resize(triangles.size());
         // Each packet is written from its own slots only: large meshes fill theirs in parallel
         // (a twentieth of the dragon's build on one thread).
-        const auto fill = [&]<int W>(auto& packets, std::size_t first_slot, std::size_t first_packet,
-                                     std::size_t end_packet) {
-            for (std::size_t k = first_packet; k < end_packet; ++k) {
-                auto& packet = packets[k];
-                for (int lane = 0; lane < W; ++lane) {
-                    const std::size_t slot = first_slot + k * W + std::size_t(lane);
-                    const auto& p = triangles[slot];
-                    for (int vertex = 0; vertex < 3; ++vertex)
-                        for (int axis = 0; axis < 3; ++axis) packet.vertices[vertex][axis][lane] = p[vertex][axis];
-                    if constexpr (keeps_sources) packet.sources[lane] = sources[slot];
-                    // The back-face test's normal, rounded as TriangleMesh's scalar loop rounds it.
-                    normals_[slot] = Vec3<Real>(glm::cross(p[1] - p[0], p[2] - p[0]));
-                }
+        const auto fill = [&](std::size_t first_packet, std::size_t end_packet) {
+            for (std::size_t slot = first_packet * N; slot < end_packet * N; ++slot) {
+                Packet& packet = packets_[slot / N];
+                const auto& p = triangles[slot];
+                for (int vertex = 0; vertex < 3; ++vertex)
+                    for (int axis = 0; axis < 3; ++axis) packet.vertices[vertex][axis][slot % N] = p[vertex][axis];
+                if constexpr (keeps_sources) packet.sources[slot % N] = sources[slot];
+                // The back-face test's normal, rounded as TriangleMesh's scalar loop rounds it.
+                normals_[slot] = Vec3<Real>(glm::cross(p[1] - p[0], p[2] - p[0]));
             }
         };
         constexpr std::size_t grain = 2048;  // packets per task
-        for_each_run(packets_.size(), grain,
-                     [&](std::size_t first, std::size_t end) { fill.template operator()<N>(packets_, 0, first, end); });
-        for_each_run(halves_.size(), grain, [&](std::size_t first, std::size_t end) {
-            fill.template operator()<half>(halves_, half_begin, first, end);
-        });
+        for_each_run(packets_.size(), grain, fill);
     }
 
     std::size_t memory_bytes() const {
-        return packets_.capacity() * sizeof(Packet<N>) + halves_.capacity() * sizeof(Packet<half>) +
-               normals_.capacity() * sizeof(Vec3<Real>);
+        return packets_.capacity() * sizeof(Packet) + normals_.capacity() * sizeof(Vec3<Real>);
     }
 
-    // Closest hit among slots [first, first + count) (a leaf of the wide BVH); lowers t_limit.
+    // Closest hit among slots [first, first + count) (first a multiple of N); lowers t_limit.
     // Forced inline into the traversal's leaf callback, as is `test`: GCC had kept it a function
     // of its own (26% of a dragon primary profile), called once per leaf.
     template <bool CullBackfaces>
     [[gnu::always_inline]] bool intersect(const PackedRay& ray, const Vec3<Real>& direction, std::uint32_t first, std::uint32_t count,
                    Real t_min, Real& t_limit, Hit<Real>& hit) const {
-        if (count <= std::uint32_t(half))
-            return accept<half, CullBackfaces>(half_packet(first), ray, ray.halved, direction, first, count, t_min, t_limit, hit);
         bool found = false;
-        for (std::uint32_t base = first; base < first + count; base += N)
-            found |= accept<N, CullBackfaces>(packets_[base / N], ray, ray.full, direction, base, first + count - base, t_min,
-                                             t_limit, hit);
+        for (std::uint32_t base = first; base < first + count; base += N) {
+            alignas(64) Storage t[N], b1[N], b2[N];
+            std::uint32_t lanes = test(packets_[base / N], ray, Storage(t_min), Storage(t_limit), t, b1, b2);
+            lanes &= lane_mask(first + count - base);
+            while (lanes != 0) {
+                const int lane = std::countr_zero(lanes);
+                lanes &= lanes - 1;
+                const std::uint32_t slot = base + std::uint32_t(lane);
+                if constexpr (CullBackfaces) {
+                    if (glm::dot(normals_[slot], direction) > 0) continue;
+                }
+                // The scalar loop's acceptance, lane by lane in slot order: later ties win.
+                if (!(t[lane] <= Storage(t_limit))) continue;
+                t_limit = Real(t[lane]);
+                hit.t = t_limit;
+                hit.primitive = slot;
+                hit.b1 = Real(b1[lane]);
+                hit.b2 = Real(b2[lane]);
+                found = true;
+            }
+        }
         return found;
     }
 
@@ -142,42 +127,38 @@ public:
     std::uint32_t source(std::uint32_t slot) const
         requires keeps_sources
     {
-        if (slot < half_begin_) return packets_[slot / N].sources[slot % N];
-        return halves_[(slot - half_begin_) / half].sources[(slot - half_begin_) % half];
+        return packets_[slot / N].sources[slot % N];
     }
 
     // Requests the packet that holds slot `first` (a leaf's first slot) from memory.
-    void prefetch(std::uint32_t first) const {
-        if (first < half_begin_)
-            simd::prefetch(packets_[first / N]);
-        else
-            simd::prefetch(half_packet(first));
-    }
+    void prefetch(std::uint32_t first) const { simd::prefetch(packets_[first / N]); }
 
     // Whether any of slots [first, first + count) is hit in (t_min, t_limit).
     [[gnu::always_inline]] bool occluded(const PackedRay& ray, std::uint32_t first, std::uint32_t count, Real t_min, Real t_limit) const {
-        if (count <= std::uint32_t(half)) return blocks<half>(half_packet(first), ray, ray.halved, count, t_min, t_limit);
-        for (std::uint32_t base = first; base < first + count; base += N)
-            if (blocks<N>(packets_[base / N], ray, ray.full, first + count - base, t_min, t_limit)) return true;
+        for (std::uint32_t base = first; base < first + count; base += N) {
+            alignas(64) Storage t[N], b1[N], b2[N];
+            std::uint32_t lanes = test(packets_[base / N], ray, Storage(t_min), Storage(t_limit), t, b1, b2);
+            lanes &= lane_mask(first + count - base);
+            while (lanes != 0) {
+                const int lane = std::countr_zero(lanes);
+                lanes &= lanes - 1;
+                // Open at t_max, as TriangleMesh's scalar test, on t rounded to Real.
+                if (Real(t[lane]) < t_limit) return true;
+            }
+        }
         return false;
     }
 
 private:
-    template <int W>
-    struct alignas(alignment<W>) PacketAlone {
-        Storage vertices[3][3][W];  // [vertex][axis][lane]
+    struct alignas(64) PacketAlone {
+        Storage vertices[3][3][N];  // [vertex][axis][lane]
     };
-    template <int W>
-    struct alignas(alignment<W>) PacketWithSources {
-        Storage vertices[3][3][W];
-        std::uint32_t sources[W];  // in the last line's otherwise unused bytes
+    struct alignas(64) PacketWithSources {
+        Storage vertices[3][3][N];
+        std::uint32_t sources[N];  // in the last line's otherwise unused bytes
     };
-    template <int W>
-    using Packet = std::conditional_t<keeps_sources, PacketWithSources<W>, PacketAlone<W>>;
-    static_assert(sizeof(Packet<N>) == sizeof(PacketAlone<N>) && sizeof(Packet<half>) == sizeof(PacketAlone<half>),
-                  "the source numbers must fit the packets' padding");
-
-    const Packet<half>& half_packet(std::uint32_t first) const { return halves_[(first - half_begin_) / half]; }
+    using Packet = std::conditional_t<keeps_sources, PacketWithSources, PacketAlone>;
+    static_assert(sizeof(Packet) == sizeof(PacketAlone), "the source numbers must fit the packet's padding");
 
     static const Watertight::Prepared<Storage>& watertight_ray(const Prepared& prepared) {
         if constexpr (std::is_same_v<Intersector, DoubleRefine>)
@@ -186,71 +167,24 @@ private:
             return prepared;
     }
 
-    template <int W>
     static std::uint32_t lane_mask(std::uint32_t remaining) {
-        return remaining >= std::uint32_t(W) ? (std::uint32_t(1) << W) - 1 : (std::uint32_t(1) << remaining) - 1;
-    }
-
-    // One packet of slots [base, base + W), of which `remaining` (or all W) are the leaf's.
-    template <int W, bool CullBackfaces>
-    [[gnu::always_inline]] bool accept(const Packet<W>& packet, const PackedRay& ray, const RayLanes<W>& lanes_of_ray,
-                                       const Vec3<Real>& direction, std::uint32_t base, std::uint32_t remaining, Real t_min,
-                                       Real& t_limit, Hit<Real>& hit) const {
-        alignas(64) Storage t[W], b1[W], b2[W];
-        std::uint32_t lanes = test<W>(packet, ray, lanes_of_ray, Storage(t_min), Storage(t_limit), t, b1, b2);
-        lanes &= lane_mask<W>(remaining);
-        bool found = false;
-        while (lanes != 0) {
-            const int lane = std::countr_zero(lanes);
-            lanes &= lanes - 1;
-            const std::uint32_t slot = base + std::uint32_t(lane);
-            if constexpr (CullBackfaces) {
-                if (glm::dot(normals_[slot], direction) > 0) continue;
-            }
-            // The scalar loop's acceptance, lane by lane in slot order: later ties win.
-            if (!(t[lane] <= Storage(t_limit))) continue;
-            t_limit = Real(t[lane]);
-            hit.t = t_limit;
-            hit.primitive = slot;
-            hit.b1 = Real(b1[lane]);
-            hit.b2 = Real(b2[lane]);
-            found = true;
-        }
-        return found;
-    }
-
-    template <int W>
-    [[gnu::always_inline]] static bool blocks(const Packet<W>& packet, const PackedRay& ray, const RayLanes<W>& lanes_of_ray,
-                                              std::uint32_t remaining, Real t_min, Real t_limit) {
-        alignas(64) Storage t[W], b1[W], b2[W];
-        std::uint32_t lanes = test<W>(packet, ray, lanes_of_ray, Storage(t_min), Storage(t_limit), t, b1, b2);
-        lanes &= lane_mask<W>(remaining);
-        while (lanes != 0) {
-            const int lane = std::countr_zero(lanes);
-            lanes &= lanes - 1;
-            // Open at t_max, as TriangleMesh's scalar test, on t rounded to Real.
-            if (Real(t[lane]) < t_limit) return true;
-        }
-        return false;
+        return remaining >= std::uint32_t(N) ? (std::uint32_t(1) << N) - 1 : (std::uint32_t(1) << remaining) - 1;
     }
 
     // Watertight::intersect on every lane: the lanes hit in (t_min, t_max], with their t and
     // barycentrics stored. Same operations, same order, so the same bits as the scalar test.
-    template <int W>
-    [[gnu::always_inline]] static std::uint32_t test(const Packet<W>& packet, const PackedRay& axes, const RayLanes<W>& ray,
-                                                     Storage t_min, Storage t_max, Storage* t_out, Storage* b1_out,
-                                                     Storage* b2_out) {
-        using Pack = PackOf<W>;
+    [[gnu::always_inline]] static std::uint32_t test(const Packet& packet, const PackedRay& ray, Storage t_min, Storage t_max,
+                              Storage* t_out, Storage* b1_out, Storage* b2_out) {
         const auto relative = [&](int vertex, int axis) {
             return Pack::load(packet.vertices[vertex][axis]) - ray.origin[axis];
         };
-        const Pack a_z = relative(0, axes.kz), b_z = relative(1, axes.kz), c_z = relative(2, axes.kz);
-        const Pack ax = relative(0, axes.kx) - ray.sx * a_z;
-        const Pack ay = relative(0, axes.ky) - ray.sy * a_z;
-        const Pack bx = relative(1, axes.kx) - ray.sx * b_z;
-        const Pack by = relative(1, axes.ky) - ray.sy * b_z;
-        const Pack cx = relative(2, axes.kx) - ray.sx * c_z;
-        const Pack cy = relative(2, axes.ky) - ray.sy * c_z;
+        const Pack a_z = relative(0, ray.kz), b_z = relative(1, ray.kz), c_z = relative(2, ray.kz);
+        const Pack ax = relative(0, ray.kx) - ray.sx * a_z;
+        const Pack ay = relative(0, ray.ky) - ray.sy * a_z;
+        const Pack bx = relative(1, ray.kx) - ray.sx * b_z;
+        const Pack by = relative(1, ray.ky) - ray.sy * b_z;
+        const Pack cx = relative(2, ray.kx) - ray.sx * c_z;
+        const Pack cy = relative(2, ray.ky) - ray.sy * c_z;
 
         Pack u = cx * by - cy * bx;
         Pack v = ax * cy - ay * cx;
@@ -259,12 +193,12 @@ private:
         if constexpr (std::is_same_v<Storage, float>) {
             // The paper's fallback to double on an exactly zero edge function, lane by lane.
             if (std::uint32_t zeros = ((u == zero) | (v == zero) | (w == zero)).bits()) {
-                alignas(64) float lanes[8][W];
+                alignas(64) float lanes[8][N];
                 const Pack* inputs[6] = {&ax, &ay, &bx, &by, &cx, &cy};
                 for (int k = 0; k < 6; ++k) inputs[k]->store(lanes[k]);
                 u.store(lanes[6]);
                 v.store(lanes[7]);
-                alignas(64) float w_lanes[W];
+                alignas(64) float w_lanes[N];
                 w.store(w_lanes);
                 while (zeros != 0) {
                     const int i = std::countr_zero(zeros);
@@ -298,10 +232,8 @@ private:
         return lanes;
     }
 
-    std::vector<Packet<N>> packets_;     // slots [0, half_begin_), N a packet
-    std::vector<Packet<half>> halves_;   // slots from half_begin_ on, N/2 a packet
-    std::vector<Vec3<Real>> normals_;    // per slot, read only when culling back faces
-    std::uint32_t half_begin_ = 0;
+    std::vector<Packet> packets_;
+    std::vector<Vec3<Real>> normals_;  // per slot, read only when culling back faces
 };
 
 // The packets a policy's meshes keep: none for the binary BVH, brute force or a scalar-only
