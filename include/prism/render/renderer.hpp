@@ -96,13 +96,23 @@ private:
                     std::vector<CameraSample<Real>>& samples, std::vector<Vec2<Real>>& scratch) const {
         const scene::PixelFilter filter = camera.filter;
         Random random = Random::for_pixel(x, y, settings_.seed);
-        camera_samples(count, random, samples, scratch);
         typename Integrator::CameraPath path{
             random, Vec2<Real>((Real(x) + Real(0.5)) / Real(lens.width()), (Real(y) + Real(0.5)) / Real(lens.height())),
             lens.pixel_spread()};
         // Integrators that render cameras differently (the path tracer's RendererParams) learn
         // the camera's choice here.
         if constexpr (requires { path.renderer; }) path.renderer = camera.renderer;
+        if (count == 1) {
+            // One sample (every hw1-hw2 camera): camera_samples' pixel centre, with its lens point
+            // and instant drawn in its order. Both filters weigh the centre exactly 1 (exp(-0)),
+            // so the weighted mean below is 0 + radiance, divided by 1: the same bits, without the
+            // sample vector and the filter's exp.
+            const Vec2<Real> lens_point = random.uniform2<Real>();
+            const Real time = random.uniform<Real>();
+            const Ray<Real> ray = lens.ray(Real(x) + Real(0.5), Real(y) + Real(0.5), lens_point, time);
+            return glm::vec3(Vec3<Real>(0) + integrator_.radiance(ray, path));
+        }
+        camera_samples(count, random, samples, scratch);
         Vec3<Real> sum(0);
         Real weights = 0;
         for (const CameraSample<Real>& sample : samples) {
