@@ -18,6 +18,7 @@
 #include <tbb/parallel_for.h>
 
 #include <cstdint>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -102,22 +103,22 @@ private:
         // Integrators that render cameras differently (the path tracer's RendererParams) learn
         // the camera's choice here.
         if constexpr (requires { path.renderer; }) path.renderer = camera.renderer;
+        // One sample (every hw1-hw2 camera) is drawn here without the sample vector; both filters
+        // weigh the pixel centre exactly 1 (exp(-0)), so its weight is not computed: the same sum
+        // and division as for any count, the same bits.
+        CameraSample<Real> centre;
+        std::span<const CameraSample<Real>> drawn(&centre, 1);
         if (count == 1) {
-            // One sample (every hw1-hw2 camera): camera_samples' pixel centre, with its lens point
-            // and instant drawn in its order. Both filters weigh the centre exactly 1 (exp(-0)),
-            // so the weighted mean below is 0 + radiance, divided by 1: the same bits, without the
-            // sample vector and the filter's exp.
-            const Vec2<Real> lens_point = random.uniform2<Real>();
-            const Real time = random.uniform<Real>();
-            const Ray<Real> ray = lens.ray(Real(x) + Real(0.5), Real(y) + Real(0.5), lens_point, time);
-            return glm::vec3(Vec3<Real>(0) + integrator_.radiance(ray, path));
+            centre = centre_sample<Real>(random);
+        } else {
+            camera_samples(count, random, samples, scratch);
+            drawn = samples;
         }
-        camera_samples(count, random, samples, scratch);
         Vec3<Real> sum(0);
         Real weights = 0;
-        for (const CameraSample<Real>& sample : samples) {
+        for (const CameraSample<Real>& sample : drawn) {
             const Ray<Real> ray = lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time);
-            const Real weight = filter_weight(filter, sample.pixel);
+            const Real weight = count == 1 ? Real(1) : filter_weight(filter, sample.pixel);
             sum += weight * integrator_.radiance(ray, path);
             weights += weight;
         }
