@@ -7,6 +7,7 @@
 #include <doctest/doctest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -15,6 +16,7 @@
 #include <iterator>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #ifndef PRISM_SHARED_DIR
@@ -60,6 +62,18 @@ glm::dvec3 mean(const prism::Image& image) {
     glm::dvec3 sum(0.0);
     for (const auto& pixel : image.pixels) sum += glm::dvec3(pixel);
     return sum / double(image.pixels.size());
+}
+
+// Noise-like values from a linear congruential stream, -20 .. 321, so that both of the 8-bit
+// conversion's clamps are taken and deflate's matches cross rows.
+prism::Image noise_image(int width, int height, std::uint32_t state) {
+    prism::Image image(width, height);
+    for (auto& pixel : image.pixels)
+        for (int c = 0; c < 3; ++c) {
+            state = state * 1664525u + 1013904223u;
+            pixel[c] = float(state >> 20) / 12.0f - 20.0f;
+        }
+    return image;
 }
 
 }  // namespace
@@ -113,16 +127,58 @@ TEST_CASE("the film is black when made, small or in huge pages, and copies whole
     }
 }
 
+TEST_CASE("copied: every pixel and the size, on one thread and in runs on two") {
+    // 5 x 3 stays on the calling thread; 1024 x 768 (786,432 pixels) is three grains of
+    // image_pass_grain, split into runs.
+    for (const auto& [width, height] : {std::pair{5, 3}, std::pair{1024, 768}}) {
+        CAPTURE(width);
+        prism::Image image(width, height, prism::Image::Unfilled{});
+        for (std::size_t i = 0; i < image.pixels.size(); ++i)
+            image.pixels[i] = glm::vec3(float(i), -float(i), float(i % 977) * 0.25f);
+        for (int threads : {1, 2}) {
+            const tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+            const prism::Image copy = prism::copied(image);
+            CHECK(copy.width == width);
+            CHECK(copy.height == height);
+            CHECK(copy.pixels == image.pixels);
+        }
+    }
+    REQUIRE(std::size_t(1024 * 768) >= 2 * prism::image_pass_grain);
+}
+
+TEST_CASE("a PPM of many row blocks and a PNG decoded in runs hold the to_8bit values") {
+    // 1024 x 768: PPM rows of 3,072 bytes, so write_ppm's 64 kB blocks hold 21 rows and the image
+    // takes 37 of them, the last one short; decode_image converts its 786,432 pixels in runs.
+    const prism::Image image = noise_image(1024, 768, 777u);
+    const auto expected = prism::to_8bit(image);
+    ScratchFolder folder("blocks");
+    const fs::path ppm = folder.path / "blocks.ppm";
+    prism::write_image(ppm, image);
+    std::ifstream stream(ppm, std::ios::binary);
+    const std::vector<std::uint8_t> written((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+    const std::string header = "P6\n1024 768\n255\n";
+    REQUIRE(written.size() == header.size() + expected.size());
+    CHECK(std::equal(header.begin(), header.end(), written.begin()));
+    CHECK(std::equal(expected.begin(), expected.end(), written.begin() + std::ptrdiff_t(header.size())));
+    for (const char* name : {"blocks.ppm", "blocks.png"}) {
+        CAPTURE(name);
+        if (std::string(name) == "blocks.png") prism::write_image(folder.path / name, image);
+        for (int threads : {1, 2}) {
+            const tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+            const prism::Image read = prism::read_image(folder.path / name);
+            REQUIRE(read.pixels.size() == image.pixels.size());
+            bool same = true;
+            for (std::size_t i = 0; i < read.pixels.size(); ++i)
+                for (int c = 0; c < 3; ++c) same = same && read.pixels[i][c] == float(expected[3 * i + std::size_t(c)]);
+            CHECK(same);
+        }
+    }
+}
+
 TEST_CASE("a PNG of many bands decodes to the to_8bit values, in the same bytes at 1 and 2 threads") {
     // 601 x 500: rows of 1,803 bytes, so png_band_rows gives 54 rows a band and ten bands, the
-    // last one short; noise-like values, so deflate's matches cross the band boundaries' rows.
-    prism::Image image(601, 500);
-    std::uint32_t state = 12345u;
-    for (auto& pixel : image.pixels)
-        for (int c = 0; c < 3; ++c) {
-            state = state * 1664525u + 1013904223u;
-            pixel[c] = float(state >> 20) / 12.0f - 20.0f;  // -20 .. 321: both clamps are taken
-        }
+    // last one short.
+    const prism::Image image = noise_image(601, 500, 12345u);
     REQUIRE(prism::detail::png_band_rows(601 * 3) < image.height / 4);
     std::vector<std::vector<std::uint8_t>> files;
     for (int threads : {1, 2}) {

@@ -13,6 +13,7 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <cstring>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -248,6 +249,47 @@ TEST_CASE_TEMPLATE("Renderer: multisampled, lens, area-lit, glossy and moving im
     // Another seed gives another image (the streams are really used).
     const prism::Renderer<Complete> reseeded(world, prism::RendererSettings{prism::BackfaceCulling::flat_triangles, prism::RayOffset::scene_epsilon, 99});
     CHECK(reseeded.render(world.cameras[0]).pixels != one.pixels);
+}
+
+TEST_CASE_TEMPLATE("Renderer: a one-sample pixel is camera_samples' one sample, weighted by the filter, bit for bit",
+                   Real, float, double) {
+    // Point lights and matte surfaces draw nothing after the camera sample, so radiance() (which
+    // starts from pixel (0, 0)'s stream) gives each pixel's radiance along its ray. A thin lens
+    // makes every pixel's ray depend on the lens point and the Gaussian filter weighs it: the
+    // one-sample path of Renderer::pixel must draw both in camera_samples' order and divide by
+    // the same weight.
+    scene::Scene world;
+    scene::Camera camera = looking_down_z(24, 16);
+    camera.num_samples = 1;
+    camera.aperture_size = 0.3;
+    camera.focus_distance = 7;
+    camera.filter = scene::PixelFilter::gaussian;
+    world.cameras.push_back(camera);
+    world.materials.push_back(matte(0.7));
+    world.planes.push_back({"floor", 0, {0, -1, 0}, {0, 1, 0}, glm::dmat4(1.0)});
+    world.spheres.push_back({"ball", 0, {0.3, 0, 0}, 1, glm::dmat4(1.0)});
+    world.point_lights.push_back({"bulb", {2, 5, 3}, {40, 40, 40}});
+    using Punctual = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::PointLightSet>;
+    const prism::Renderer<Punctual> renderer(world);
+    const prism::Image image = renderer.render(world.cameras[0]);
+    const prism::ThinLensCamera<Real> lens(camera, camera.width, camera.height);
+    std::vector<prism::CameraSample<Real>> samples;
+    std::vector<prism::Vec2<Real>> scratch;
+    int mismatches = 0, lit = 0;
+    for (int y = 0; y < camera.height; ++y)
+        for (int x = 0; x < camera.width; ++x) {
+            prism::Random random = prism::Random::for_pixel(x, y, 0);
+            prism::camera_samples(1, random, samples, scratch);
+            const prism::CameraSample<Real>& sample = samples[0];
+            const prism::Ray<Real> ray =
+                lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time);
+            const Real weight = prism::filter_weight(camera.filter, sample.pixel);
+            const glm::vec3 expected((prism::Vec3<Real>(0) + weight * renderer.radiance(ray)) / (Real(0) + weight));
+            mismatches += std::memcmp(&expected, &image(x, y), sizeof expected) != 0;
+            lit += expected.r > 0.0f;
+        }
+    CHECK(mismatches == 0);
+    CHECK(lit > 50);  // the light reaches the ball and the floor
 }
 
 TEST_CASE("render_scene: a fitted renderer refuses what it was compiled without") {

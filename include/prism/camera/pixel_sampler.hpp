@@ -53,6 +53,16 @@ void stratified_2d(int n, Random& random, std::vector<Vec2<Real>>& points) {
 
 }  // namespace detail
 
+// The sample of a one-sample pixel: the pixel centre, as the course's single-sample images are
+// rendered; lens and time still vary between pixels (drawn in that order).
+template <Scalar Real>
+CameraSample<Real> centre_sample(Random& random) {
+    CameraSample<Real> sample;
+    sample.lens = random.uniform2<Real>();
+    sample.time = random.uniform<Real>();
+    return sample;
+}
+
 // Fills `samples` with the pixel's `count` camera samples from its random stream. `scratch`
 // avoids reallocating per pixel.
 template <Scalar Real>
@@ -60,9 +70,7 @@ void camera_samples(int count, Random& random, std::vector<CameraSample<Real>>& 
                     std::vector<Vec2<Real>>& scratch) {
     samples.resize(std::size_t(count));
     if (count == 1) {
-        // One sample: the pixel centre, as the course's single-sample images are rendered; lens
-        // and time still vary between pixels.
-        samples[0] = {Vec2<Real>(Real(0.5)), random.uniform2<Real>(), random.uniform<Real>()};
+        samples[0] = centre_sample<Real>(random);
         return;
     }
     detail::stratified_2d(count, random, scratch);

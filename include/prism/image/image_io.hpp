@@ -114,11 +114,22 @@ inline std::string stb_failure() {
 
 // Binary PPM (P6), the output format of the course's 2017-2019 scenes (their cameras name
 // `.ppm` images): the same to_8bit bytes a PNG would hold, uncompressed.
+// Written in blocks of rows through one small buffer: converting the whole image first took a
+// fresh buffer of 2-3.5 MB per course image, whose page faults cost as much as the conversion,
+// on the main thread after the render (ocornellbox writes three).
 inline void write_ppm(const std::filesystem::path& path, const Image& image, const std::filesystem::path& shown) {
-    const std::vector<std::uint8_t> bytes = to_8bit(image);
     std::ofstream out(path, std::ios::binary);
     out << "P6\n" << image.width << ' ' << image.height << "\n255\n";
-    out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    const std::size_t row = std::size_t(image.width) * 3;
+    const std::size_t block_rows = std::max<std::size_t>(1, (std::size_t(64) << 10) / row);
+    std::vector<std::uint8_t> bytes;
+    for (std::size_t y = 0; y < std::size_t(image.height) && out; y += block_rows) {
+        const std::size_t rows = std::min(block_rows, std::size_t(image.height) - y);
+        const float* channels = &image.pixels[y * std::size_t(image.width)].x;  // glm's vec3: 3 packed floats
+        bytes.resize(rows * row);
+        for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = channel_to_8bit(channels[i]);
+        out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    }
     out.close();
     if (!out) throw io::LoadError(shown, "ImageName", "cannot write the PPM file");
 }
@@ -300,9 +311,13 @@ inline Image decode_image(std::string_view bytes, const std::filesystem::path& p
     detail::check_image_size(path, image.width, image.height, max_pixels);
     const auto copy = [&](const auto* data) {
         if (!data) throw io::LoadError(path, "", "cannot read the image: " + detail::stb_failure());
+        // Default-initialised pixels, converted in runs on TBB's threads: the fresh pages' first
+        // touch is most of this loop's time (image.hpp, copied).
         image.pixels.resize(std::size_t(image.width) * std::size_t(image.height));
-        for (std::size_t i = 0; i < image.pixels.size(); ++i)
-            image.pixels[i] = glm::vec3(float(data[3 * i]), float(data[3 * i + 1]), float(data[3 * i + 2]));
+        for_each_run(image.pixels.size(), image_pass_grain, [&](std::size_t first, std::size_t end) {
+            for (std::size_t i = first; i < end; ++i)
+                image.pixels[i] = glm::vec3(float(data[3 * i]), float(data[3 * i + 1]), float(data[3 * i + 2]));
+        });
         stbi_image_free(const_cast<void*>(static_cast<const void*>(data)));
     };
     // stbi_loadf for .hdr: linear radiance must not be squeezed to 8 bits. stbi_load, not

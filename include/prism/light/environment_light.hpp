@@ -69,7 +69,7 @@ public:
         if (pixels.width <= 0 || pixels.height <= 0 ||
             pixels.pixels.size() != std::size_t(pixels.width) * std::size_t(pixels.height))
             throw io::LoadError(scene.source, element, "its image is empty");
-        return EnvironmentMap<Real>(std::make_shared<const Image>(pixels), light.layout, Vec3<Real>(light.scale));
+        return EnvironmentMap<Real>(std::make_shared<const Image>(copied(pixels)), light.layout, Vec3<Real>(light.scale));
     }
 
     LightSample<Real> sample(const ShadingFrame<Real>& at, const Vec2<Real>& u) const {

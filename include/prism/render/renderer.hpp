@@ -18,6 +18,7 @@
 #include <tbb/parallel_for.h>
 
 #include <cstdint>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -96,18 +97,28 @@ private:
                     std::vector<CameraSample<Real>>& samples, std::vector<Vec2<Real>>& scratch) const {
         const scene::PixelFilter filter = camera.filter;
         Random random = Random::for_pixel(x, y, settings_.seed);
-        camera_samples(count, random, samples, scratch);
         typename Integrator::CameraPath path{
             random, Vec2<Real>((Real(x) + Real(0.5)) / Real(lens.width()), (Real(y) + Real(0.5)) / Real(lens.height())),
             lens.pixel_spread()};
         // Integrators that render cameras differently (the path tracer's RendererParams) learn
         // the camera's choice here.
         if constexpr (requires { path.renderer; }) path.renderer = camera.renderer;
+        // One sample (every hw1-hw2 camera) is drawn here without the sample vector; both filters
+        // weigh the pixel centre exactly 1 (exp(-0)), so its weight is not computed: the same sum
+        // and division as for any count, the same bits.
+        CameraSample<Real> centre;
+        std::span<const CameraSample<Real>> drawn(&centre, 1);
+        if (count == 1) {
+            centre = centre_sample<Real>(random);
+        } else {
+            camera_samples(count, random, samples, scratch);
+            drawn = samples;
+        }
         Vec3<Real> sum(0);
         Real weights = 0;
-        for (const CameraSample<Real>& sample : samples) {
+        for (const CameraSample<Real>& sample : drawn) {
             const Ray<Real> ray = lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time);
-            const Real weight = filter_weight(filter, sample.pixel);
+            const Real weight = count == 1 ? Real(1) : filter_weight(filter, sample.pixel);
             sum += weight * integrator_.radiance(ray, path);
             weights += weight;
         }
