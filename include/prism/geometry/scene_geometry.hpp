@@ -142,6 +142,7 @@ public:
         if constexpr (requires { Index::build(boxes, top_options); }) top_ = Index::build(boxes, top_options);
         else top_ = Index::build(boxes);
         choose_direct_spheres(scene);
+        choose_direct_world_meshes();
     }
 
     std::size_t instance_count() const { return instances_.size(); }
@@ -177,7 +178,7 @@ public:
     // (geometry/backface_culling.hpp).
     template <BackfaceCulling Culling = BackfaceCulling::none>
     bool intersect(Ray<Real>& ray, Hit<Real>& hit) const {
-        if (world_meshes_.empty() && !direct_spheres_.empty()) return intersect_direct<Culling>(ray, hit, false);
+        if (direct_) return intersect_direct<Culling>(ray, hit, !world_meshes_.empty() && intersect_world_leaves<Culling>(ray, hit));
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;  // made when the ray first enters a mesh
         // The merged world-space meshes first: their hit lowers t_max before the top level
@@ -237,7 +238,7 @@ public:
 
     // Whether anything lies in (ray.t_min, ray.t_max).
     bool occluded(const Ray<Real>& ray) const {
-        if (world_meshes_.empty() && !direct_spheres_.empty()) return occluded_direct(ray);
+        if (direct_) return (!world_meshes_.empty() && occluded_world_leaves(ray)) || occluded_direct(ray);
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;
         std::optional<RayBoxPrecomputed<Real>> box_ray;
@@ -700,6 +701,80 @@ private:
         return occluded_by_planes(ray);
     }
 
+    // A scene whose top level is tested without its index (direct spheres, or nothing but the
+    // world-space meshes and planes) and whose world-space indices are each one leaf (at most N
+    // triangles: the course's floors, walls and mirrors of two to six) is tested without the
+    // TraversalRay: each index's leaf directly (TriangleMesh::intersect_leaf), then the spheres
+    // and planes. The TraversalRay (three divisions, broadcast) and the root's box test were
+    // a fifth of hw1 simple_reflectance's profile (a two-triangle floor and one sphere). The
+    // hits are the index's: traversal of a single leaf tests that leaf, in the same slot order
+    // with the same t_max; only a ray whose box test the index would fail is now tested too,
+    // and the conservative box (Ize's widened exit) fails only rays that miss the triangles.
+    void choose_direct_world_meshes() {
+        if (!top_objects_.empty() && direct_spheres_.empty()) return;
+        for (WorldMeshes& group : world_meshes_) {
+            const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
+            group.leaf = index.single_leaf();
+            if (!group.leaf) return;
+        }
+        direct_ = true;
+    }
+
+    // Whether the ray starts outside the box beyond one of its faces and does not move towards
+    // it (a floor's rays that start above it and go up: most shadow and reflected rays), with
+    // t_min >= 0. The index's slab test rejects every such ray without a division: the far
+    // plane's distance (face - origin) / direction is negative, or -inf for a zero direction
+    // of either sign, or the near plane's +inf, so the exit falls below the entry. (Only a
+    // distance that underflows to -0, an origin within a subnormal's width of the face, would
+    // pass that test; the ray then starts on the box and the leaf test decides, as here.)
+    [[gnu::always_inline]] static bool leaves_box(const Aabb<Real>& box, const Ray<Real>& ray) {
+        bool away = false;
+        for (int axis = 0; axis < 3; ++axis)
+            away |= (ray.origin[axis] > box.max[axis] && ray.direction[axis] >= 0) |
+                    (ray.origin[axis] < box.min[axis] && ray.direction[axis] <= 0);
+        return away && ray.t_min >= 0;
+    }
+
+    // The world-space meshes' leaves for intersect's direct path: hit or not, and hit filled as
+    // intersect's loop over the indices fills it.
+    template <BackfaceCulling Culling>
+    bool intersect_world_leaves(Ray<Real>& ray, Hit<Real>& hit) const {
+        if constexpr (Mesh::packed) {
+            std::optional<TriangleRay> triangle_ray;  // made for the first leaf the ray may reach
+            bool found = false;
+            for (const WorldMeshes& group : world_meshes_) {
+                if (leaves_box(group.leaf->box, ray)) continue;
+                if (!triangle_ray) triangle_ray.emplace(ray);
+                const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
+                const bool cull =
+                    Culling == BackfaceCulling::all || (Culling == BackfaceCulling::flat_triangles && !group.smooth);
+                const bool group_hit = cull ? index.template intersect_leaf<true>(ray, *triangle_ray, *group.leaf, ray.t_max, hit)
+                                            : index.template intersect_leaf<false>(ray, *triangle_ray, *group.leaf, ray.t_max, hit);
+                if (group_hit) {
+                    if (group.index) group.attribute(index.source_triangle(hit.primitive), hit);
+                    else hit.object = group.objects[0];
+                    found = true;
+                }
+            }
+            return found;
+        } else {
+            return false;  // single_leaf() is empty without packets: direct_ stays false
+        }
+    }
+
+    bool occluded_world_leaves(const Ray<Real>& ray) const {
+        if constexpr (Mesh::packed) {
+            std::optional<TriangleRay> triangle_ray;
+            for (const WorldMeshes& group : world_meshes_) {
+                if (leaves_box(group.leaf->box, ray)) continue;
+                if (!triangle_ray) triangle_ray.emplace(ray);
+                const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
+                if (index.occluded_leaf(ray, *triangle_ray, *group.leaf, ray.t_max)) return true;
+            }
+        }
+        return false;
+    }
+
     // The merged meshes of one culling class and the index over their triangles.
     struct WorldMeshes {
         // Over the parts' triangles, numbered part after part; none for a single part, which
@@ -708,6 +783,7 @@ private:
         bool smooth = false;        // its parts' culling class
         std::vector<std::uint32_t> objects;         // per part, its object (Hit::object)
         std::vector<std::uint32_t> first_triangle;  // per part, the number of its first triangle
+        std::optional<typename Mesh::Leaf> leaf;     // the index's one leaf, when it is one (direct_)
 
         // The hit on triangle `number` of the index (hit.primitive holds the index's slot)
         // as a hit on its own mesh: its object, its triangle there (the file's order, which
@@ -724,6 +800,7 @@ private:
     std::vector<WorldMeshes> world_meshes_;
     std::vector<std::uint32_t> top_objects_;  // the top level's primitives: the objects not merged
     std::vector<DirectSphere> direct_spheres_;  // the top level's objects, when tested without it
+    bool direct_ = false;  // no TraversalRay: the top level direct, the world meshes' leaves too
     Aabb<Real> bounds_;
     std::vector<SphereShape<Real>> spheres_;
     std::vector<PlaneShape<Real>> planes_;
