@@ -2,7 +2,10 @@
 // most 4 spheres tested one after another (SceneGeometry's direct spheres) finds the hits and
 // the occlusions the top-level index finds, bit for bit, on random and grazing rays, with and
 // without a world-space mesh beside it, for plain, translated and scaled-rotated spheres; and
-// Blinn-Phong's power is left out only where the sum it enters is the same without it.
+// Blinn-Phong's power is left out only where the sum it enters is the same without it; and
+// world-space meshes of a few triangles beside such a top level, tested leaf by leaf without
+// their indices (their traversal ray, their root's box test), find the same hits, ties on the
+// quads' diagonals and rays that start on or graze their boxes' faces included.
 #include <prism/geometry/scene_geometry.hpp>
 #include <prism/material/material.hpp>
 
@@ -122,6 +125,147 @@ TEST_CASE_TEMPLATE("SceneGeometry: a top level of a few spheres tested directly 
         CHECK(blocked > rays / 4);
         }
     }
+}
+
+// World-space meshes of a few triangles: a floor quad and a tilted wall quad (flat: one merged
+// index of two parts), a small smooth tent (its own index), one sphere and a plane.
+scene::Scene tiny_meshes() {
+    scene::Scene world;
+    world.materials.push_back({});
+    world.spheres.push_back({"ball", 0, {0.5, 0, 0.25}, 0.75, glm::dmat4(1.0)});
+    world.planes.push_back({"wall", 0, {0, 0, -8}, glm::normalize(glm::dvec3(0.1, 0.2, 1)), glm::dmat4(1.0)});
+    scene::Mesh floor;
+    floor.positions = {{-4, -1.5, -4}, {4, -1.5, -4}, {4, -1.5, 4}, {-4, -1.5, 4}};
+    floor.triangles = {{0, 2, 1}, {0, 3, 2}};
+    world.meshes.push_back(floor);
+    scene::Mesh mirror;
+    mirror.positions = {{-3, -1, -3}, {1, -0.5, -3.5}, {1.5, 2.5, -3.2}, {-2.5, 2, -2.7}};
+    mirror.triangles = {{0, 1, 2}, {0, 2, 3}};
+    world.meshes.push_back(mirror);
+    scene::Mesh tent;
+    tent.shading = scene::ShadingMode::smooth;
+    tent.positions = {{2, -1.5, 1}, {3.5, -1.5, 1}, {3.5, -1.5, 2.5}, {2, -1.5, 2.5}, {2.75, 0.5, 1.75}};
+    tent.triangles = {{0, 4, 1}, {1, 4, 2}, {2, 4, 3}, {3, 4, 0}};
+    world.meshes.push_back(tent);
+    return world;
+}
+
+TEST_CASE_TEMPLATE("SceneGeometry: tiny world-space meshes tested without their index find what the index finds", Real,
+                   float, double) {
+    using Geometry = prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>;
+    using Vec3 = prism::Vec3<Real>;
+    const scene::Scene direct_world = tiny_meshes();
+    // Five far spheres take the top level past the direct limit: the same objects, and the world
+    // meshes through their indices' traversal.
+    scene::Scene indexed_world = direct_world;
+    for (int i = 0; i < 5; ++i) indexed_world.spheres.push_back({"far", 0, {1e4 + 10 * i, 1e4, 1e4}, 1e-3, glm::dmat4(1.0)});
+    const Geometry direct(direct_world), indexed(indexed_world);
+    REQUIRE(direct.merged_mesh_count() == 3);
+
+    std::mt19937 random(13);
+    std::uniform_real_distribution<double> uniform(-1, 1);
+    const auto unit = [&] {
+        glm::dvec3 v;
+        do v = {uniform(random), uniform(random), uniform(random)};
+        while (glm::dot(v, v) > 1 || glm::dot(v, v) < 1e-6);
+        return glm::normalize(v);
+    };
+    // Targets on the meshes: a vertex, a point on an edge (the quads' shared diagonals, where
+    // two triangles tie), or inside a triangle.
+    std::vector<const scene::Mesh*> meshes;
+    for (const auto& mesh : direct_world.meshes) meshes.push_back(&mesh);
+    const auto target = [&](int i) {
+        const scene::Mesh& mesh = *meshes[std::size_t(i) % meshes.size()];
+        const auto& face = mesh.triangles[std::size_t(i / 3) % mesh.triangles.size()];
+        const double a = 0.5 * (1 + uniform(random)), b = 0.5 * (1 + uniform(random));
+        const glm::dvec3 p0 = mesh.positions[face[0]], p1 = mesh.positions[face[1]], p2 = mesh.positions[face[2]];
+        switch (i % 4) {
+            case 0: return p1;
+            case 1: return p0 + a * (p2 - p0);  // the quads' diagonal
+            case 2: return p0 + a * (p1 - p0);
+            default: return p0 + a * (1 - b) * (p1 - p0) + a * b * (p2 - p0);
+        }
+    };
+    const prism::BackfaceCulling cullings[] = {prism::BackfaceCulling::none, prism::BackfaceCulling::flat_triangles,
+                                               prism::BackfaceCulling::all};
+    std::size_t hits = 0, mesh_hits = 0, blocked = 0, rays = 0;
+    for (int i = 0; i < 120000; ++i) {
+        glm::dvec3 origin, direction;
+        switch (i % 5) {
+            case 0:  // anywhere
+                origin = 6.0 * glm::dvec3(uniform(random), uniform(random), uniform(random));
+                direction = unit();
+                break;
+            case 1:
+            case 2: {  // through a vertex, an edge or a face, some grazing by 1e-6
+                const glm::dvec3 point = target(i / 5);
+                origin = point + (0.5 + 5 * std::abs(uniform(random))) * unit();
+                direction = glm::normalize(point - origin);
+                if (i % 10 == 2) direction = glm::normalize(direction + 1e-6 * unit());
+                break;
+            }
+            case 3: {  // from the floor's plane or one ulp above or below it, some level with it
+                origin = glm::dvec3(5 * uniform(random), -1.5, 5 * uniform(random));
+                direction = unit();
+                if (i % 15 == 3) direction.y = 0.0;
+                if (i % 15 == 8) direction.y = -0.0;
+                break;
+            }
+            default: {  // along the box faces of the floor and the tent, within a few ulps
+                origin = glm::dvec3(6 * uniform(random), 2 * uniform(random), 6 * uniform(random));
+                const double faces[] = {-4, 4, 2, 3.5};
+                origin[i % 2 == 0 ? 0 : 2] = faces[std::size_t(i / 5) % 4];
+                direction = unit();
+                direction[i % 2 == 0 ? 0 : 2] = (i / 7) % 3 == 0 ? 0.0 : ((i / 7) % 3 == 1 ? -0.0 : direction[i % 2 == 0 ? 0 : 2]);
+            }
+        }
+        prism::Ray<Real> ray{Vec3(origin), Vec3(direction), Real(0), Real(40)};
+        if (i % 5 == 3) {
+            const int step = (i / 5) % 3 - 1;  // the plane itself, or one representable value off
+            if (step > 0) ray.origin.y = std::nextafter(ray.origin.y, Real(1));
+            if (step < 0) ray.origin.y = std::nextafter(ray.origin.y, Real(-2));
+        }
+        if (i % 5 == 4 && (i / 3) % 2 == 0) {
+            const int axis = i % 2 == 0 ? 0 : 2;
+            ray.origin[axis] = std::nextafter(ray.origin[axis], (i / 11) % 2 == 0 ? Real(10) : Real(-10));
+        }
+        if (i % 3 == 0) ray.t_max = Real(6 * std::abs(uniform(random)));
+        if (i % 7 == 0 && i % 5 == 1) ray.t_max = Real(glm::length(target(i / 5) - origin));  // ending on a mesh
+        for (const prism::BackfaceCulling culling : cullings) {
+            CAPTURE(i);
+            CAPTURE(int(culling));
+            ++rays;
+            prism::Ray<Real> a = ray, b = ray;
+            prism::Hit<Real> hit_a, hit_b;
+            const auto closest = [&](const Geometry& geometry, prism::Ray<Real>& r, prism::Hit<Real>& hit) {
+                switch (culling) {
+                    case prism::BackfaceCulling::none: return geometry.intersect(r, hit);
+                    case prism::BackfaceCulling::flat_triangles:
+                        return geometry.template intersect<prism::BackfaceCulling::flat_triangles>(r, hit);
+                    default: return geometry.template intersect<prism::BackfaceCulling::all>(r, hit);
+                }
+            };
+            const bool found_a = closest(direct, a, hit_a), found_b = closest(indexed, b, hit_b);
+            REQUIRE(found_a == found_b);
+            if (culling == prism::BackfaceCulling::none) CHECK(direct.occluded(ray) == indexed.occluded(ray));
+            if (!found_a) continue;
+            ++hits;
+            blocked += direct.occluded(ray);
+            CHECK(same_bits(hit_a.t, hit_b.t));
+            CHECK(same_bits(a.t_max, b.t_max));
+            CHECK(same_bits(hit_a.b1, hit_b.b1));
+            CHECK(same_bits(hit_a.b2, hit_b.b2));
+            const auto plane_or_object = [](const Geometry& geometry, std::uint32_t object) {
+                return object >= geometry.instance_count() ? 1000 + (object - geometry.instance_count()) : std::size_t(object);
+            };
+            CHECK(plane_or_object(direct, hit_a.object) == plane_or_object(indexed, hit_b.object));
+            CHECK(hit_a.primitive == hit_b.primitive);
+            mesh_hits += hit_a.object < 3;
+        }
+    }
+    CHECK(hits > rays / 3);
+    CHECK(mesh_hits > rays / 5);
+    CHECK(blocked > rays / 4);
 }
 
 TEST_CASE_TEMPLATE("Blinn-Phong: the power is left out only where the sum is the same without it", Real, float, double) {
