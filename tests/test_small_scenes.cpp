@@ -1,5 +1,5 @@
 // The shortcuts of scenes of a few spheres and planes, for float and double: a top level of at
-// most 4 spheres tested one after another (SceneGeometry's direct spheres) finds the hits and
+// most 8 spheres tested one after another (SceneGeometry's direct spheres) finds the hits and
 // the occlusions the top-level index finds, bit for bit, on random and grazing rays, with and
 // without a world-space mesh beside it, for plain, translated and scaled-rotated spheres; and
 // Blinn-Phong's power is left out only where the sum it enters is the same without it; and
@@ -25,7 +25,8 @@ namespace scene = prism::scene;
 
 // Spheres of every kind the direct test distinguishes, a plane, and optionally a floor of two
 // triangles (a world-space mesh, tested before the top level).
-scene::Scene few_spheres(bool with_mesh) {
+// `more` adds four spheres in reach, for a top level of 8: the direct test's limit.
+scene::Scene few_spheres(bool with_mesh, bool more = false) {
     scene::Scene world;
     world.materials.push_back({});
     world.spheres.push_back({"plain", 0, {0, 0, 0}, 1.0, glm::dmat4(1.0)});
@@ -38,6 +39,13 @@ scene::Scene few_spheres(bool with_mesh) {
     world.spheres.push_back({"flattened", 0, {0, 0, 0}, 0.5,
                              glm::scale(glm::translate(glm::dmat4(1.0), glm::dvec3(0, 2.5, 0)), glm::dvec3(3, 0.1, 3))});
     world.planes.push_back({"wall", 0, {0, 0, -4}, glm::normalize(glm::dvec3(0.1, 0.2, 1)), glm::dmat4(1.0)});
+    if (more) {
+        world.spheres.push_back({"small", 0, {1, -1, 2}, 0.4, glm::dmat4(1.0)});
+        world.spheres.push_back({"moved", 0, {0, 0, 0}, 0.6, glm::translate(glm::dmat4(1.0), glm::dvec3(-2, -0.5, 2.5))});
+        world.spheres.push_back({"overlapping", 0, {0.8, 0.3, 0}, 0.5, glm::dmat4(1.0)});
+        world.spheres.push_back({"stretched", 0, {0, 0, 0}, 0.3,
+                                 glm::scale(glm::translate(glm::dmat4(1.0), glm::dvec3(2, 1.5, 2)), glm::dvec3(1, 4, 1))});
+    }
     if (with_mesh) {
         scene::Mesh floor;
         floor.positions = {{-6, -1.5, -6}, {6, -1.5, -6}, {6, -1.5, 6}, {-6, -1.5, 6}};
@@ -57,13 +65,15 @@ bool same_bits(Real a, Real b) {
 TEST_CASE_TEMPLATE("SceneGeometry: a top level of a few spheres tested directly finds what the index finds", Real, float,
                    double) {
     using Geometry = prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>;
+    for (const bool more : {false, true})
     for (const bool with_mesh : {false, true}) {
         for (const prism::BackfaceCulling culling : {prism::BackfaceCulling::none, prism::BackfaceCulling::flat_triangles}) {
         CAPTURE(int(culling));
         CAPTURE(with_mesh);
-        const scene::Scene direct_world = few_spheres(with_mesh);
+        CAPTURE(more);
+        const scene::Scene direct_world = few_spheres(with_mesh, more);
         // Five more spheres, tiny and far beyond every ray's reach (t_max below), take the top
-        // level past the direct test's limit of 4: the same objects, through the index.
+        // level past the direct test's limit of 8: the same objects, through the index.
         scene::Scene indexed_world = direct_world;
         for (int i = 0; i < 5; ++i)
             indexed_world.spheres.push_back({"far", 0, {1e4 + 10 * i, 1e4, 1e4}, 1e-3, glm::dmat4(1.0)});
@@ -155,10 +165,10 @@ TEST_CASE_TEMPLATE("SceneGeometry: tiny world-space meshes tested without their 
     using Geometry = prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>;
     using Vec3 = prism::Vec3<Real>;
     const scene::Scene direct_world = tiny_meshes();
-    // Five far spheres take the top level past the direct limit: the same objects, and the world
-    // meshes through their indices' traversal.
+    // Eight far spheres take the top level past the direct limit: the same objects, and the
+    // world meshes through their indices' traversal.
     scene::Scene indexed_world = direct_world;
-    for (int i = 0; i < 5; ++i) indexed_world.spheres.push_back({"far", 0, {1e4 + 10 * i, 1e4, 1e4}, 1e-3, glm::dmat4(1.0)});
+    for (int i = 0; i < 8; ++i) indexed_world.spheres.push_back({"far", 0, {1e4 + 10 * i, 1e4, 1e4}, 1e-3, glm::dmat4(1.0)});
     const Geometry direct(direct_world), indexed(indexed_world);
     REQUIRE(direct.merged_mesh_count() == 3);
 
