@@ -138,7 +138,8 @@ TEST_CASE_TEMPLATE("SceneGeometry: a top level of a few spheres tested directly 
 }
 
 // World-space meshes of a few triangles: a floor quad and a tilted wall quad (flat: one merged
-// index of two parts), a small smooth tent (its own index), one sphere and a plane.
+// index of two parts), a small smooth tent (its own index); a transformed plate and an instance
+// of it in the top level; one sphere and a plane.
 scene::Scene tiny_meshes() {
     scene::Scene world;
     world.materials.push_back({});
@@ -157,6 +158,19 @@ scene::Scene tiny_meshes() {
     tent.positions = {{2, -1.5, 1}, {3.5, -1.5, 1}, {3.5, -1.5, 2.5}, {2, -1.5, 2.5}, {2.75, 0.5, 1.75}};
     tent.triangles = {{0, 4, 1}, {1, 4, 2}, {2, 4, 3}, {3, 4, 0}};
     world.meshes.push_back(tent);
+    // A transformed plate and an instance of it: top-level meshes of one leaf, tested directly
+    // in their object space.
+    scene::Mesh plate;
+    plate.positions = {{-1, 0, -1}, {1, 0, -1}, {1, 0, 1}, {-1, 0, 1}};
+    plate.triangles = {{0, 2, 1}, {0, 3, 2}};
+    plate.transform = glm::rotate(glm::translate(glm::dmat4(1.0), glm::dvec3(-2, 0.5, 1.5)), 0.9,
+                                  glm::normalize(glm::dvec3(1, 0.3, -0.5)));
+    plate.transform = glm::scale(plate.transform, glm::dvec3(1.2, 1, 0.7));
+    world.meshes.push_back(plate);
+    scene::MeshInstance copy;
+    copy.base_mesh = 3;
+    copy.transform = glm::scale(glm::translate(glm::dmat4(1.0), glm::dvec3(1.5, 1.5, -1.5)), glm::dvec3(0.8, 1, 1.5));
+    world.mesh_instances.push_back(copy);
     return world;
 }
 
@@ -171,6 +185,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: tiny world-space meshes tested without their 
     for (int i = 0; i < 8; ++i) indexed_world.spheres.push_back({"far", 0, {1e4 + 10 * i, 1e4, 1e4}, 1e-3, glm::dmat4(1.0)});
     const Geometry direct(direct_world), indexed(indexed_world);
     REQUIRE(direct.merged_mesh_count() == 3);
+    REQUIRE(direct.instance_count() == 6);
 
     std::mt19937 random(13);
     std::uniform_real_distribution<double> uniform(-1, 1);
@@ -182,13 +197,16 @@ TEST_CASE_TEMPLATE("SceneGeometry: tiny world-space meshes tested without their 
     };
     // Targets on the meshes: a vertex, a point on an edge (the quads' shared diagonals, where
     // two triangles tie), or inside a triangle.
-    std::vector<const scene::Mesh*> meshes;
-    for (const auto& mesh : direct_world.meshes) meshes.push_back(&mesh);
+    std::vector<std::pair<const scene::Mesh*, glm::dmat4>> meshes;
+    for (const auto& mesh : direct_world.meshes) meshes.push_back({&mesh, mesh.transform});
+    meshes.push_back({&direct_world.meshes[3], direct_world.mesh_instances[0].transform});
     const auto target = [&](int i) {
-        const scene::Mesh& mesh = *meshes[std::size_t(i) % meshes.size()];
+        const auto& [mesh_pointer, transform] = meshes[std::size_t(i) % meshes.size()];
+        const scene::Mesh& mesh = *mesh_pointer;
         const auto& face = mesh.triangles[std::size_t(i / 3) % mesh.triangles.size()];
         const double a = 0.5 * (1 + uniform(random)), b = 0.5 * (1 + uniform(random));
-        const glm::dvec3 p0 = mesh.positions[face[0]], p1 = mesh.positions[face[1]], p2 = mesh.positions[face[2]];
+        const auto world = [&](std::uint32_t v) { return glm::dvec3(transform * glm::dvec4(mesh.positions[v], 1.0)); };
+        const glm::dvec3 p0 = world(face[0]), p1 = world(face[1]), p2 = world(face[2]);
         switch (i % 4) {
             case 0: return p1;
             case 1: return p0 + a * (p2 - p0);  // the quads' diagonal
@@ -198,7 +216,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: tiny world-space meshes tested without their 
     };
     const prism::BackfaceCulling cullings[] = {prism::BackfaceCulling::none, prism::BackfaceCulling::flat_triangles,
                                                prism::BackfaceCulling::all};
-    std::size_t hits = 0, mesh_hits = 0, blocked = 0, rays = 0;
+    std::size_t hits = 0, mesh_hits = 0, top_mesh_hits = 0, blocked = 0, rays = 0;
     for (int i = 0; i < 120000; ++i) {
         glm::dvec3 origin, direction;
         switch (i % 5) {
@@ -270,11 +288,13 @@ TEST_CASE_TEMPLATE("SceneGeometry: tiny world-space meshes tested without their 
             };
             CHECK(plane_or_object(direct, hit_a.object) == plane_or_object(indexed, hit_b.object));
             CHECK(hit_a.primitive == hit_b.primitive);
-            mesh_hits += hit_a.object < 3;
+            mesh_hits += hit_a.object < 5;
+            top_mesh_hits += hit_a.object == 3 || hit_a.object == 4;
         }
     }
     CHECK(hits > rays / 3);
     CHECK(mesh_hits > rays / 5);
+    CHECK(top_mesh_hits > rays / 20);
     CHECK(blocked > rays / 4);
 }
 

@@ -143,7 +143,7 @@ public:
         top_options.max_leaf_size = 1;
         if constexpr (requires { Index::build(boxes, top_options); }) top_ = Index::build(boxes, top_options);
         else top_ = Index::build(boxes);
-        choose_direct_spheres(scene);
+        choose_direct_top_level(scene);
         choose_direct_world_meshes();
     }
 
@@ -201,7 +201,7 @@ public:
                 found = true;
             }
         }
-        if (!direct_spheres_.empty()) return intersect_direct<Culling>(ray, hit, found);
+        if (direct_top_) return intersect_direct<Culling>(ray, hit, found);
         if (top_objects_.empty()) return intersect_planes<Culling>(ray, hit) || found;
         const auto& order = top_.primitive_indices();
         top_.traverse_closest(traversal_ray, ray.t_min, ray.t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_max) {
@@ -250,7 +250,7 @@ public:
             if (!world_triangle_ray) world_triangle_ray.emplace(ray);
             if (index.occluded(ray, traversal_ray, *world_triangle_ray, ray.t_max)) return true;
         }
-        if (!direct_spheres_.empty()) return occluded_direct(ray);
+        if (direct_top_) return occluded_direct(ray);
         const auto& order = top_.primitive_indices();
         const bool blocked =
             !top_objects_.empty() &&
@@ -488,6 +488,13 @@ private:
             for (int c = 0; c < 8; ++c)
                 instance.world_bounds.extend(
                     Vec3<Real>(transform * glm::dvec4(glm::dvec3(object_bounds.corner(c)), 1.0)));
+            // The corners are rounded to nearest, so the box could fall inside the transformed
+            // object by half an ulp: rays through a silhouette vertex on it were lost (found by
+            // the direct test of test_small_scenes). One ulp outwards keeps it conservative.
+            for (int axis = 0; axis < 3; ++axis) {
+                instance.world_bounds.min[axis] = next_down(instance.world_bounds.min[axis]);
+                instance.world_bounds.max[axis] = next_up(instance.world_bounds.max[axis]);
+            }
         } else {
             instance.world_bounds = object_bounds;
         }
@@ -602,7 +609,7 @@ private:
     // untransformed spheres (hw1 spheres_with_plane, spheres.json) had cost more than the
     // index's one 8-wide box test (1.04-1.05 of its CPU time, whole3).
     static constexpr int direct_width = 8;
-    static constexpr std::size_t direct_sphere_limit = direct_width;
+    static constexpr std::size_t direct_limit = direct_width;
     using DirectPack = simd::Pack<Real, direct_width>;
     struct DirectSphere {
         std::uint32_t object = 0;
@@ -611,6 +618,15 @@ private:
         // or by the instance's matrix.
         enum class Map : std::uint8_t { none, translation, matrix } map = Map::none;
         Vec3<Real> translation{0};
+    };
+    // A mesh of the top level small enough for one leaf (a transformed floor or plate of a few
+    // triangles): the ray is taken to its object space and the leaf tested there, as the
+    // instance's own index would after the top level's box test. Rays that leave the leaf's box
+    // by a face are culled in object space first, as that index's slab test rejects them;
+    // only rays the world box alone would have stopped are tested too, and they miss.
+    struct DirectMesh {
+        std::uint32_t object = 0;
+        typename Mesh::Leaf leaf;
     };
     // Around each direct sphere, lane by lane, a world-space sphere widened so that may_hit
     // never rejects a ray the object-space test hits: it culls as the index's box did. Lanes
@@ -621,14 +637,21 @@ private:
         std::uint32_t lanes = 0;
     };
 
-    void choose_direct_spheres(const scene::Scene& scene) {
-        if (top_objects_.empty() || top_objects_.size() > direct_sphere_limit) return;
+    void choose_direct_top_level(const scene::Scene& scene) {
+        if (top_objects_.empty() || top_objects_.size() > direct_limit) return;
         const std::size_t first_sphere = scene.meshes.size() + scene.mesh_instances.size();
         std::vector<DirectSphere> chosen;
+        std::vector<DirectMesh> meshes;
         DirectBounds bounds;
         for (const std::uint32_t object : top_objects_) {
             const Instance& instance = instances_[object];
-            if (instance.kind != Kind::sphere || instance.moving) return;
+            if (instance.moving) return;
+            if (instance.kind == Kind::mesh) {
+                const std::optional<typename Mesh::Leaf> leaf = meshes_[instance.shape].single_leaf();
+                if (!leaf) return;
+                meshes.push_back({object, *leaf});
+                continue;
+            }
             DirectSphere direct;
             direct.object = object;
             if (instance.transformed) {
@@ -656,7 +679,9 @@ private:
             chosen.push_back(direct);
         }
         direct_spheres_ = std::move(chosen);
+        direct_meshes_ = std::move(meshes);
         direct_bounds_ = bounds;
+        direct_top_ = true;
     }
 
     // Which direct spheres the ray may meet (bit i for sphere i): lane by lane, false only where
@@ -712,6 +737,21 @@ private:
             hit.object = sphere.object;
             found = true;
         }
+        if constexpr (Mesh::packed) {
+            for (const DirectMesh& direct : direct_meshes_) {
+                const Instance& instance = instances_[direct.object];
+                const Ray<Real> local = to_object(instance, ray);
+                if (leaves_box(direct.leaf.box, local)) continue;
+                const Mesh& mesh = meshes_[instance.shape];
+                const TriangleRay triangle_ray(local);
+                const bool cull = Culling == BackfaceCulling::all || (Culling == BackfaceCulling::flat_triangles && !mesh.smooth());
+                if (cull ? mesh.template intersect_leaf<true>(local, triangle_ray, direct.leaf, ray.t_max, hit)
+                         : mesh.template intersect_leaf<false>(local, triangle_ray, direct.leaf, ray.t_max, hit)) {
+                    hit.object = direct.object;
+                    found = true;
+                }
+            }
+        }
         return intersect_planes<Culling>(ray, hit) || found;
     }
 
@@ -720,6 +760,14 @@ private:
             const DirectSphere& sphere = direct_spheres_[std::size_t(std::countr_zero(lanes))];
             Real t;
             if (direct_hit(sphere, ray, ray.t_max, t) && t < ray.t_max) return true;
+        }
+        if constexpr (Mesh::packed) {
+            for (const DirectMesh& direct : direct_meshes_) {
+                const Instance& instance = instances_[direct.object];
+                const Ray<Real> local = to_object(instance, ray);
+                if (leaves_box(direct.leaf.box, local)) continue;
+                if (meshes_[instance.shape].occluded_leaf(local, TriangleRay(local), direct.leaf, ray.t_max)) return true;
+            }
         }
         return occluded_by_planes(ray);
     }
@@ -734,7 +782,7 @@ private:
     // with the same t_max; only a ray whose box test the index would fail is now tested too,
     // and the conservative box (Ize's widened exit) fails only rays that miss the triangles.
     void choose_direct_world_meshes() {
-        if (!top_objects_.empty() && direct_spheres_.empty()) return;
+        if (!top_objects_.empty() && !direct_top_) return;
         for (WorldMeshes& group : world_meshes_) {
             const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
             group.leaf = index.single_leaf();
@@ -822,7 +870,10 @@ private:
     std::vector<TriangleMesh<Real, Policy>> meshes_;
     std::vector<WorldMeshes> world_meshes_;
     std::vector<std::uint32_t> top_objects_;  // the top level's primitives: the objects not merged
-    std::vector<DirectSphere> direct_spheres_;  // the top level's objects, when tested without it
+    // The top level's objects when it is tested without its index (direct_top_).
+    std::vector<DirectSphere> direct_spheres_;
+    std::vector<DirectMesh> direct_meshes_;
+    bool direct_top_ = false;
     DirectBounds direct_bounds_;
     bool direct_ = false;  // no TraversalRay: the top level direct, the world meshes' leaves too
     Aabb<Real> bounds_;
