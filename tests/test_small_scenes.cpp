@@ -5,7 +5,8 @@
 // Blinn-Phong's power is left out only where the sum it enters is the same without it; and
 // world-space meshes of a few triangles beside such a top level, tested leaf by leaf without
 // their indices (their traversal ray, their root's box test), find the same hits, ties on the
-// quads' diagonals and rays that start on or graze their boxes' faces included.
+// quads' diagonals and rays that start on or graze their boxes' faces included; and planes,
+// tested eight at a time, give what each plane's own test gives, one after another.
 #include <prism/geometry/scene_geometry.hpp>
 #include <prism/material/material.hpp>
 
@@ -296,6 +297,76 @@ TEST_CASE_TEMPLATE("SceneGeometry: tiny world-space meshes tested without their 
     CHECK(mesh_hits > rays / 5);
     CHECK(top_mesh_hits > rays / 20);
     CHECK(blocked > rays / 4);
+}
+
+TEST_CASE_TEMPLATE("SceneGeometry: planes tested eight at a time find what one after another finds", Real, float, double) {
+    using Geometry = prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>;
+    using Vec3 = prism::Vec3<Real>;
+    std::mt19937 random(17);
+    std::uniform_real_distribution<double> uniform(-1, 1);
+    const auto unit = [&] {
+        glm::dvec3 v;
+        do v = {uniform(random), uniform(random), uniform(random)};
+        while (glm::dot(v, v) > 1 || glm::dot(v, v) < 1e-6);
+        return glm::normalize(v);
+    };
+    // Eleven planes (a full block of eight and three more): a room's axis-aligned walls, two of
+    // them at the same place facing opposite ways (ties), and tilted ones.
+    scene::Scene world;
+    world.materials.push_back({});
+    const glm::dvec3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (int i = 0; i < 6; ++i)
+        world.planes.push_back({"wall", 0, (i % 2 == 0 ? -3.0 : 3.0) * axes[i / 2], (i % 2 == 0 ? 1.0 : -1.0) * axes[i / 2],
+                                glm::dmat4(1.0)});
+    world.planes.push_back({"twin", 0, {0, -3, 0}, {0, -1, 0}, glm::dmat4(1.0)});
+    for (int i = 0; i < 4; ++i) world.planes.push_back({"tilted", 0, 2.0 * unit(), unit(), glm::dmat4(1.0)});
+    std::vector<prism::PlaneShape<Real>> planes;
+    for (const auto& plane : world.planes) planes.push_back({Vec3(plane.point), Vec3(glm::normalize(plane.normal))});
+    const Geometry geometry(world);
+    REQUIRE(geometry.instance_count() == 0);
+
+    std::size_t hits = 0, rays = 0;
+    for (int i = 0; i < 100000; ++i) {
+        prism::Ray<Real> ray{Vec3(4.0 * glm::dvec3(uniform(random), uniform(random), uniform(random))), Vec3(unit()), Real(0),
+                             prism::infinity<Real>};
+        if (i % 4 == 1) ray.t_max = Real(4 * std::abs(uniform(random)));
+        if (i % 4 == 2) ray.origin.y = Real(-3);  // on the twin walls
+        if (i % 8 == 3) ray.direction.x = Real(0);  // parallel to two walls
+        if (i % 16 == 5) ray.t_min = Real(-1);
+        for (const bool cull : {false, true}) {
+            ++rays;
+            // The loop intersect_planes replaced: each plane's own test, in order.
+            prism::Ray<Real> expected_ray = ray;
+            bool expected = false;
+            std::uint32_t expected_plane = 0;
+            for (std::size_t p = 0; p < planes.size(); ++p) {
+                Real t;
+                if (!planes[p].intersect(expected_ray, expected_ray.t_min, expected_ray.t_max, t)) continue;
+                if (cull && glm::dot(expected_ray.direction, planes[p].normal) > 0) continue;
+                expected_ray.t_max = t;
+                expected_plane = std::uint32_t(p);
+                expected = true;
+            }
+            prism::Ray<Real> found_ray = ray;
+            prism::Hit<Real> hit;
+            const bool found = cull ? geometry.template intersect<prism::BackfaceCulling::all>(found_ray, hit)
+                                    : geometry.intersect(found_ray, hit);
+            REQUIRE(found == expected);
+            CHECK(same_bits(found_ray.t_max, expected_ray.t_max));
+            if (found) {
+                ++hits;
+                CHECK(same_bits(hit.t, expected_ray.t_max));
+                CHECK(hit.object == expected_plane);
+            }
+        }
+        bool blocked = false;
+        for (const auto& plane : planes) {
+            Real t;
+            blocked |= plane.intersect(ray, ray.t_min, ray.t_max, t) && t < ray.t_max;
+        }
+        CHECK(geometry.occluded(ray) == blocked);
+    }
+    CHECK(hits > rays / 2);
 }
 
 TEST_CASE_TEMPLATE("Blinn-Phong: the power is left out only where the sum is the same without it", Real, float, double) {

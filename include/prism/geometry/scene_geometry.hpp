@@ -106,6 +106,14 @@ public:
             const glm::dvec3 normal =
                 glm::normalize(glm::transpose(glm::inverse(glm::dmat3(plane.transform))) * plane.normal);
             planes_.push_back({Vec3<Real>(point), Vec3<Real>(normal)});
+            if (planes_.size() % direct_width == 1) plane_blocks_.emplace_back();
+            PlaneBlock& block = plane_blocks_.back();
+            const std::size_t lane = (planes_.size() - 1) % direct_width;
+            for (int axis = 0; axis < 3; ++axis) {
+                block.point[axis][lane] = planes_.back().point[axis];
+                block.normal[axis][lane] = planes_.back().normal[axis];
+            }
+            block.lanes |= std::uint32_t(1) << lane;
             plane_materials_.push_back(std::uint32_t(plane.material));
             plane_textures_.push_back(add_texture_list(plane.textures));
         }
@@ -222,16 +230,21 @@ public:
     // Planes are unbounded, so no index holds them: every ray tests each one (closest hit, as
     // intersect above).
     template <BackfaceCulling Culling = BackfaceCulling::none>
+    // Eight planes at a time (plane_distances); the lanes are then accepted in order as one
+    // plane after another would be, so the hit is the scalar loop's.
     bool intersect_planes(Ray<Real>& ray, Hit<Real>& hit) const {
         bool found = false;
-        for (std::size_t p = 0; p < planes_.size(); ++p) {
-            Real t;
-            if (planes_[p].intersect(ray, ray.t_min, ray.t_max, t)) {
+        for (std::size_t b = 0; b < plane_blocks_.size(); ++b) {
+            alignas(64) Real t[direct_width];
+            alignas(64) Real denominator[direct_width];
+            for (std::uint32_t lanes = plane_distances(plane_blocks_[b], ray, t, denominator); lanes != 0; lanes &= lanes - 1) {
+                const int lane = std::countr_zero(lanes);
+                if (!(t[lane] <= ray.t_max)) continue;
                 if constexpr (Culling == BackfaceCulling::all) {
-                    if (glm::dot(ray.direction, planes_[p].normal) > 0) continue;
+                    if (denominator[lane] > 0) continue;
                 }
-                ray.t_max = t;
-                hit = Hit<Real>{t, std::uint32_t(instances_.size() + p), 0, 0, 0};
+                ray.t_max = t[lane];
+                hit = Hit<Real>{t[lane], std::uint32_t(instances_.size() + b * direct_width + std::size_t(lane)), 0, 0, 0};
                 found = true;
             }
         }
@@ -264,9 +277,11 @@ public:
     }
 
     bool occluded_by_planes(const Ray<Real>& ray) const {
-        for (const auto& plane : planes_) {
-            Real t;
-            if (plane.intersect(ray, ray.t_min, ray.t_max, t) && t < ray.t_max) return true;
+        for (const PlaneBlock& block : plane_blocks_) {
+            alignas(64) Real t[direct_width];
+            alignas(64) Real denominator[direct_width];
+            for (std::uint32_t lanes = plane_distances(block, ray, t, denominator); lanes != 0; lanes &= lanes - 1)
+                if (t[std::countr_zero(lanes)] < ray.t_max) return true;
         }
         return false;
     }
@@ -619,6 +634,36 @@ private:
         enum class Map : std::uint8_t { none, translation, matrix } map = Map::none;
         Vec3<Real> translation{0};
     };
+    // Up to eight planes SoA, for one SIMD pass of PlaneShape::intersect's arithmetic.
+    struct PlaneBlock {
+        alignas(64) Real point[3][direct_width] = {};
+        alignas(64) Real normal[3][direct_width] = {};
+        std::uint32_t lanes = 0;  // the planes present
+    };
+
+    // PlaneShape::intersect for a block's planes, lane by lane with its operations in its order
+    // (the dot products as glm sums them): bit i set where plane i is met in (t_min, ...) with a
+    // t that t_max has not yet been compared with; t and the denominator (direction . normal)
+    // stored. The scalar test's shortcut for planes behind the ray only skips a division whose
+    // t would fail t > t_min >= 0 anyway, so every lane divides.
+    [[gnu::always_inline]] static std::uint32_t plane_distances(const PlaneBlock& block, const Ray<Real>& ray, Real* t,
+                                                                Real* denominator) {
+        DirectPack normal[3], along[3];
+        for (int axis = 0; axis < 3; ++axis) {
+            normal[axis] = DirectPack::load(block.normal[axis]);
+            along[axis] = DirectPack::load(block.point[axis]) - DirectPack::broadcast(ray.origin[axis]);
+        }
+        const DirectPack d = (DirectPack::broadcast(ray.direction.x) * normal[0] +
+                              DirectPack::broadcast(ray.direction.y) * normal[1]) +
+                             DirectPack::broadcast(ray.direction.z) * normal[2];
+        const DirectPack numerator = (along[0] * normal[0] + along[1] * normal[1]) + along[2] * normal[2];
+        const DirectPack distance = numerator / d;
+        d.store(denominator);
+        distance.store(t);
+        const std::uint32_t met = ((d != DirectPack::broadcast(Real(0))) & (DirectPack::broadcast(ray.t_min) < distance)).bits();
+        return met & block.lanes;
+    }
+
     // A mesh of the top level small enough for one leaf (a transformed floor or plate of a few
     // triangles): the ray is taken to its object space and the leaf tested there, as the
     // instance's own index would after the top level's box test. Rays that leave the leaf's box
@@ -879,6 +924,7 @@ private:
     Aabb<Real> bounds_;
     std::vector<SphereShape<Real>> spheres_;
     std::vector<PlaneShape<Real>> planes_;
+    std::vector<PlaneBlock> plane_blocks_;  // planes_, eight to a block
     std::vector<std::uint32_t> plane_materials_;
     std::vector<std::uint32_t> plane_textures_;
     // Each object's texture indices; entry 0 is the empty list that untextured objects share.
