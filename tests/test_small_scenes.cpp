@@ -56,6 +56,22 @@ scene::Scene few_spheres(bool with_mesh, bool more = false) {
     return world;
 }
 
+// A direction uniform on the sphere.
+glm::dvec3 random_unit(std::mt19937& random) {
+    std::uniform_real_distribution<double> uniform(-1, 1);
+    glm::dvec3 v;
+    do v = {uniform(random), uniform(random), uniform(random)};
+    while (glm::dot(v, v) > 1 || glm::dot(v, v) < 1e-6);
+    return glm::normalize(v);
+}
+
+// The same scene with `count` tiny spheres far beyond every ray's reach, which take its top
+// level past the direct test's limit of 8: the same objects, through the index.
+scene::Scene past_direct_limit(scene::Scene world, int count) {
+    for (int i = 0; i < count; ++i) world.spheres.push_back({"far", 0, {1e4 + 10 * i, 1e4, 1e4}, 1e-3, glm::dmat4(1.0)});
+    return world;
+}
+
 template <class Real>
 bool same_bits(Real a, Real b) {
     return std::memcmp(&a, &b, sizeof(Real)) == 0;
@@ -73,21 +89,11 @@ TEST_CASE_TEMPLATE("SceneGeometry: a top level of a few spheres tested directly 
         CAPTURE(with_mesh);
         CAPTURE(more);
         const scene::Scene direct_world = few_spheres(with_mesh, more);
-        // Five more spheres, tiny and far beyond every ray's reach (t_max below), take the top
-        // level past the direct test's limit of 8: the same objects, through the index.
-        scene::Scene indexed_world = direct_world;
-        for (int i = 0; i < 5; ++i)
-            indexed_world.spheres.push_back({"far", 0, {1e4 + 10 * i, 1e4, 1e4}, 1e-3, glm::dmat4(1.0)});
-        const Geometry direct(direct_world), indexed(indexed_world);
+        const Geometry direct(direct_world), indexed(past_direct_limit(direct_world, 5));
 
         std::mt19937 random(7);
         std::uniform_real_distribution<double> uniform(-1, 1);
-        const auto unit = [&] {
-            glm::dvec3 v;
-            do v = {uniform(random), uniform(random), uniform(random)};
-            while (glm::dot(v, v) > 1 || glm::dot(v, v) < 1e-6);
-            return glm::normalize(v);
-        };
+        const auto unit = [&] { return random_unit(random); };
         // Points on each sphere's surface, in world space, for rays that pass through them or
         // just graze them (the rays the bounding spheres' margins are for).
         const auto surface_point = [&](std::size_t s) {
@@ -180,22 +186,14 @@ TEST_CASE_TEMPLATE("SceneGeometry: tiny world-space meshes tested without their 
     using Geometry = prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>;
     using Vec3 = prism::Vec3<Real>;
     const scene::Scene direct_world = tiny_meshes();
-    // Eight far spheres take the top level past the direct limit: the same objects, and the
-    // world meshes through their indices' traversal.
-    scene::Scene indexed_world = direct_world;
-    for (int i = 0; i < 8; ++i) indexed_world.spheres.push_back({"far", 0, {1e4 + 10 * i, 1e4, 1e4}, 1e-3, glm::dmat4(1.0)});
-    const Geometry direct(direct_world), indexed(indexed_world);
+    // The world meshes through their indices' traversal too.
+    const Geometry direct(direct_world), indexed(past_direct_limit(direct_world, 8));
     REQUIRE(direct.merged_mesh_count() == 3);
     REQUIRE(direct.instance_count() == 6);
 
     std::mt19937 random(13);
     std::uniform_real_distribution<double> uniform(-1, 1);
-    const auto unit = [&] {
-        glm::dvec3 v;
-        do v = {uniform(random), uniform(random), uniform(random)};
-        while (glm::dot(v, v) > 1 || glm::dot(v, v) < 1e-6);
-        return glm::normalize(v);
-    };
+    const auto unit = [&] { return random_unit(random); };
     // Targets on the meshes: a vertex, a point on an edge (the quads' shared diagonals, where
     // two triangles tie), or inside a triangle.
     std::vector<std::pair<const scene::Mesh*, glm::dmat4>> meshes;
@@ -304,12 +302,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: planes tested eight at a time find what one a
     using Vec3 = prism::Vec3<Real>;
     std::mt19937 random(17);
     std::uniform_real_distribution<double> uniform(-1, 1);
-    const auto unit = [&] {
-        glm::dvec3 v;
-        do v = {uniform(random), uniform(random), uniform(random)};
-        while (glm::dot(v, v) > 1 || glm::dot(v, v) < 1e-6);
-        return glm::normalize(v);
-    };
+    const auto unit = [&] { return random_unit(random); };
     // Eleven planes (a full block of eight and three more): a room's axis-aligned walls, two of
     // them at the same place facing opposite ways (ties), and tilted ones.
     scene::Scene world;
