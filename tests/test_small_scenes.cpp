@@ -1,8 +1,12 @@
 // The shortcuts of scenes of a few spheres and planes, for float and double: a top level of at
-// most 4 spheres tested one after another (SceneGeometry's direct spheres) finds the hits and
+// most 8 spheres tested one after another (SceneGeometry's direct spheres) finds the hits and
 // the occlusions the top-level index finds, bit for bit, on random and grazing rays, with and
 // without a world-space mesh beside it, for plain, translated and scaled-rotated spheres; and
-// Blinn-Phong's power is left out only where the sum it enters is the same without it.
+// Blinn-Phong's power is left out only where the sum it enters is the same without it; and
+// world-space meshes of a few triangles beside such a top level, tested leaf by leaf without
+// their indices (their traversal ray, their root's box test), find the same hits, ties on the
+// quads' diagonals and rays that start on or graze their boxes' faces included; and planes,
+// tested eight at a time, give what each plane's own test gives, one after another.
 #include <prism/geometry/scene_geometry.hpp>
 #include <prism/material/material.hpp>
 
@@ -22,7 +26,8 @@ namespace scene = prism::scene;
 
 // Spheres of every kind the direct test distinguishes, a plane, and optionally a floor of two
 // triangles (a world-space mesh, tested before the top level).
-scene::Scene few_spheres(bool with_mesh) {
+// `more` adds four spheres in reach, for a top level of 8: the direct test's limit.
+scene::Scene few_spheres(bool with_mesh, bool more = false) {
     scene::Scene world;
     world.materials.push_back({});
     world.spheres.push_back({"plain", 0, {0, 0, 0}, 1.0, glm::dmat4(1.0)});
@@ -35,12 +40,35 @@ scene::Scene few_spheres(bool with_mesh) {
     world.spheres.push_back({"flattened", 0, {0, 0, 0}, 0.5,
                              glm::scale(glm::translate(glm::dmat4(1.0), glm::dvec3(0, 2.5, 0)), glm::dvec3(3, 0.1, 3))});
     world.planes.push_back({"wall", 0, {0, 0, -4}, glm::normalize(glm::dvec3(0.1, 0.2, 1)), glm::dmat4(1.0)});
+    if (more) {
+        world.spheres.push_back({"small", 0, {1, -1, 2}, 0.4, glm::dmat4(1.0)});
+        world.spheres.push_back({"moved", 0, {0, 0, 0}, 0.6, glm::translate(glm::dmat4(1.0), glm::dvec3(-2, -0.5, 2.5))});
+        world.spheres.push_back({"overlapping", 0, {0.8, 0.3, 0}, 0.5, glm::dmat4(1.0)});
+        world.spheres.push_back({"stretched", 0, {0, 0, 0}, 0.3,
+                                 glm::scale(glm::translate(glm::dmat4(1.0), glm::dvec3(2, 1.5, 2)), glm::dvec3(1, 4, 1))});
+    }
     if (with_mesh) {
         scene::Mesh floor;
         floor.positions = {{-6, -1.5, -6}, {6, -1.5, -6}, {6, -1.5, 6}, {-6, -1.5, 6}};
         floor.triangles = {{0, 2, 1}, {0, 3, 2}};
         world.meshes.push_back(floor);
     }
+    return world;
+}
+
+// A direction uniform on the sphere.
+glm::dvec3 random_unit(std::mt19937& random) {
+    std::uniform_real_distribution<double> uniform(-1, 1);
+    glm::dvec3 v;
+    do v = {uniform(random), uniform(random), uniform(random)};
+    while (glm::dot(v, v) > 1 || glm::dot(v, v) < 1e-6);
+    return glm::normalize(v);
+}
+
+// The same scene with `count` tiny spheres far beyond every ray's reach, which take its top
+// level past the direct test's limit of 8: the same objects, through the index.
+scene::Scene past_direct_limit(scene::Scene world, int count) {
+    for (int i = 0; i < count; ++i) world.spheres.push_back({"far", 0, {1e4 + 10 * i, 1e4, 1e4}, 1e-3, glm::dmat4(1.0)});
     return world;
 }
 
@@ -54,26 +82,18 @@ bool same_bits(Real a, Real b) {
 TEST_CASE_TEMPLATE("SceneGeometry: a top level of a few spheres tested directly finds what the index finds", Real, float,
                    double) {
     using Geometry = prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>;
+    for (const bool more : {false, true})
     for (const bool with_mesh : {false, true}) {
         for (const prism::BackfaceCulling culling : {prism::BackfaceCulling::none, prism::BackfaceCulling::flat_triangles}) {
         CAPTURE(int(culling));
         CAPTURE(with_mesh);
-        const scene::Scene direct_world = few_spheres(with_mesh);
-        // Five more spheres, tiny and far beyond every ray's reach (t_max below), take the top
-        // level past the direct test's limit of 4: the same objects, through the index.
-        scene::Scene indexed_world = direct_world;
-        for (int i = 0; i < 5; ++i)
-            indexed_world.spheres.push_back({"far", 0, {1e4 + 10 * i, 1e4, 1e4}, 1e-3, glm::dmat4(1.0)});
-        const Geometry direct(direct_world), indexed(indexed_world);
+        CAPTURE(more);
+        const scene::Scene direct_world = few_spheres(with_mesh, more);
+        const Geometry direct(direct_world), indexed(past_direct_limit(direct_world, 5));
 
         std::mt19937 random(7);
         std::uniform_real_distribution<double> uniform(-1, 1);
-        const auto unit = [&] {
-            glm::dvec3 v;
-            do v = {uniform(random), uniform(random), uniform(random)};
-            while (glm::dot(v, v) > 1 || glm::dot(v, v) < 1e-6);
-            return glm::normalize(v);
-        };
+        const auto unit = [&] { return random_unit(random); };
         // Points on each sphere's surface, in world space, for rays that pass through them or
         // just graze them (the rays the bounding spheres' margins are for).
         const auto surface_point = [&](std::size_t s) {
@@ -122,6 +142,224 @@ TEST_CASE_TEMPLATE("SceneGeometry: a top level of a few spheres tested directly 
         CHECK(blocked > rays / 4);
         }
     }
+}
+
+// World-space meshes of a few triangles: a floor quad and a tilted wall quad (flat: one merged
+// index of two parts), a small smooth tent (its own index); a transformed plate and an instance
+// of it in the top level; one sphere and a plane.
+scene::Scene tiny_meshes() {
+    scene::Scene world;
+    world.materials.push_back({});
+    world.spheres.push_back({"ball", 0, {0.5, 0, 0.25}, 0.75, glm::dmat4(1.0)});
+    world.planes.push_back({"wall", 0, {0, 0, -8}, glm::normalize(glm::dvec3(0.1, 0.2, 1)), glm::dmat4(1.0)});
+    scene::Mesh floor;
+    floor.positions = {{-4, -1.5, -4}, {4, -1.5, -4}, {4, -1.5, 4}, {-4, -1.5, 4}};
+    floor.triangles = {{0, 2, 1}, {0, 3, 2}};
+    world.meshes.push_back(floor);
+    scene::Mesh mirror;
+    mirror.positions = {{-3, -1, -3}, {1, -0.5, -3.5}, {1.5, 2.5, -3.2}, {-2.5, 2, -2.7}};
+    mirror.triangles = {{0, 1, 2}, {0, 2, 3}};
+    world.meshes.push_back(mirror);
+    scene::Mesh tent;
+    tent.shading = scene::ShadingMode::smooth;
+    tent.positions = {{2, -1.5, 1}, {3.5, -1.5, 1}, {3.5, -1.5, 2.5}, {2, -1.5, 2.5}, {2.75, 0.5, 1.75}};
+    tent.triangles = {{0, 4, 1}, {1, 4, 2}, {2, 4, 3}, {3, 4, 0}};
+    world.meshes.push_back(tent);
+    // A transformed plate and an instance of it: top-level meshes of one leaf, tested directly
+    // in their object space.
+    scene::Mesh plate;
+    plate.positions = {{-1, 0, -1}, {1, 0, -1}, {1, 0, 1}, {-1, 0, 1}};
+    plate.triangles = {{0, 2, 1}, {0, 3, 2}};
+    plate.transform = glm::rotate(glm::translate(glm::dmat4(1.0), glm::dvec3(-2, 0.5, 1.5)), 0.9,
+                                  glm::normalize(glm::dvec3(1, 0.3, -0.5)));
+    plate.transform = glm::scale(plate.transform, glm::dvec3(1.2, 1, 0.7));
+    world.meshes.push_back(plate);
+    scene::MeshInstance copy;
+    copy.base_mesh = 3;
+    copy.transform = glm::scale(glm::translate(glm::dmat4(1.0), glm::dvec3(1.5, 1.5, -1.5)), glm::dvec3(0.8, 1, 1.5));
+    world.mesh_instances.push_back(copy);
+    return world;
+}
+
+TEST_CASE_TEMPLATE("SceneGeometry: tiny world-space meshes tested without their index find what the index finds", Real,
+                   float, double) {
+    using Geometry = prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>;
+    using Vec3 = prism::Vec3<Real>;
+    const scene::Scene direct_world = tiny_meshes();
+    // The world meshes through their indices' traversal too.
+    const Geometry direct(direct_world), indexed(past_direct_limit(direct_world, 8));
+    REQUIRE(direct.merged_mesh_count() == 3);
+    REQUIRE(direct.instance_count() == 6);
+
+    std::mt19937 random(13);
+    std::uniform_real_distribution<double> uniform(-1, 1);
+    const auto unit = [&] { return random_unit(random); };
+    // Targets on the meshes: a vertex, a point on an edge (the quads' shared diagonals, where
+    // two triangles tie), or inside a triangle.
+    std::vector<std::pair<const scene::Mesh*, glm::dmat4>> meshes;
+    for (const auto& mesh : direct_world.meshes) meshes.push_back({&mesh, mesh.transform});
+    meshes.push_back({&direct_world.meshes[3], direct_world.mesh_instances[0].transform});
+    const auto target = [&](int i) {
+        const auto& [mesh_pointer, transform] = meshes[std::size_t(i) % meshes.size()];
+        const scene::Mesh& mesh = *mesh_pointer;
+        const auto& face = mesh.triangles[std::size_t(i / 3) % mesh.triangles.size()];
+        const double a = 0.5 * (1 + uniform(random)), b = 0.5 * (1 + uniform(random));
+        const auto world = [&](std::uint32_t v) { return glm::dvec3(transform * glm::dvec4(mesh.positions[v], 1.0)); };
+        const glm::dvec3 p0 = world(face[0]), p1 = world(face[1]), p2 = world(face[2]);
+        switch (i % 4) {
+            case 0: return p1;
+            case 1: return p0 + a * (p2 - p0);  // the quads' diagonal
+            case 2: return p0 + a * (p1 - p0);
+            default: return p0 + a * (1 - b) * (p1 - p0) + a * b * (p2 - p0);
+        }
+    };
+    const prism::BackfaceCulling cullings[] = {prism::BackfaceCulling::none, prism::BackfaceCulling::flat_triangles,
+                                               prism::BackfaceCulling::all};
+    std::size_t hits = 0, mesh_hits = 0, top_mesh_hits = 0, blocked = 0, rays = 0;
+    for (int i = 0; i < 120000; ++i) {
+        glm::dvec3 origin, direction;
+        switch (i % 5) {
+            case 0:  // anywhere
+                origin = 6.0 * glm::dvec3(uniform(random), uniform(random), uniform(random));
+                direction = unit();
+                break;
+            case 1:
+            case 2: {  // through a vertex, an edge or a face, some grazing by 1e-6
+                const glm::dvec3 point = target(i / 5);
+                origin = point + (0.5 + 5 * std::abs(uniform(random))) * unit();
+                direction = glm::normalize(point - origin);
+                if (i % 10 == 2) direction = glm::normalize(direction + 1e-6 * unit());
+                break;
+            }
+            case 3: {  // from the floor's plane or one ulp above or below it, some level with it
+                origin = glm::dvec3(5 * uniform(random), -1.5, 5 * uniform(random));
+                direction = unit();
+                if (i % 15 == 3) direction.y = 0.0;
+                if (i % 15 == 8) direction.y = -0.0;
+                break;
+            }
+            default: {  // along the box faces of the floor and the tent, within a few ulps
+                origin = glm::dvec3(6 * uniform(random), 2 * uniform(random), 6 * uniform(random));
+                const double faces[] = {-4, 4, 2, 3.5};
+                origin[i % 2 == 0 ? 0 : 2] = faces[std::size_t(i / 5) % 4];
+                direction = unit();
+                direction[i % 2 == 0 ? 0 : 2] = (i / 7) % 3 == 0 ? 0.0 : ((i / 7) % 3 == 1 ? -0.0 : direction[i % 2 == 0 ? 0 : 2]);
+            }
+        }
+        prism::Ray<Real> ray{Vec3(origin), Vec3(direction), Real(0), Real(40)};
+        if (i % 5 == 3) {
+            const int step = (i / 5) % 3 - 1;  // the plane itself, or one representable value off
+            if (step > 0) ray.origin.y = std::nextafter(ray.origin.y, Real(1));
+            if (step < 0) ray.origin.y = std::nextafter(ray.origin.y, Real(-2));
+        }
+        if (i % 5 == 4 && (i / 3) % 2 == 0) {
+            const int axis = i % 2 == 0 ? 0 : 2;
+            ray.origin[axis] = std::nextafter(ray.origin[axis], (i / 11) % 2 == 0 ? Real(10) : Real(-10));
+        }
+        if (i % 3 == 0) ray.t_max = Real(6 * std::abs(uniform(random)));
+        if (i % 7 == 0 && i % 5 == 1) ray.t_max = Real(glm::length(target(i / 5) - origin));  // ending on a mesh
+        for (const prism::BackfaceCulling culling : cullings) {
+            CAPTURE(i);
+            CAPTURE(int(culling));
+            ++rays;
+            prism::Ray<Real> a = ray, b = ray;
+            prism::Hit<Real> hit_a, hit_b;
+            const auto closest = [&](const Geometry& geometry, prism::Ray<Real>& r, prism::Hit<Real>& hit) {
+                switch (culling) {
+                    case prism::BackfaceCulling::none: return geometry.intersect(r, hit);
+                    case prism::BackfaceCulling::flat_triangles:
+                        return geometry.template intersect<prism::BackfaceCulling::flat_triangles>(r, hit);
+                    default: return geometry.template intersect<prism::BackfaceCulling::all>(r, hit);
+                }
+            };
+            const bool found_a = closest(direct, a, hit_a), found_b = closest(indexed, b, hit_b);
+            REQUIRE(found_a == found_b);
+            if (culling == prism::BackfaceCulling::none) CHECK(direct.occluded(ray) == indexed.occluded(ray));
+            if (!found_a) continue;
+            ++hits;
+            blocked += direct.occluded(ray);
+            CHECK(same_bits(hit_a.t, hit_b.t));
+            CHECK(same_bits(a.t_max, b.t_max));
+            CHECK(same_bits(hit_a.b1, hit_b.b1));
+            CHECK(same_bits(hit_a.b2, hit_b.b2));
+            const auto plane_or_object = [](const Geometry& geometry, std::uint32_t object) {
+                return object >= geometry.instance_count() ? 1000 + (object - geometry.instance_count()) : std::size_t(object);
+            };
+            CHECK(plane_or_object(direct, hit_a.object) == plane_or_object(indexed, hit_b.object));
+            CHECK(hit_a.primitive == hit_b.primitive);
+            mesh_hits += hit_a.object < 5;
+            top_mesh_hits += hit_a.object == 3 || hit_a.object == 4;
+        }
+    }
+    CHECK(hits > rays / 3);
+    CHECK(mesh_hits > rays / 5);
+    CHECK(top_mesh_hits > rays / 20);
+    CHECK(blocked > rays / 4);
+}
+
+TEST_CASE_TEMPLATE("SceneGeometry: planes tested eight at a time find what one after another finds", Real, float, double) {
+    using Geometry = prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>;
+    using Vec3 = prism::Vec3<Real>;
+    std::mt19937 random(17);
+    std::uniform_real_distribution<double> uniform(-1, 1);
+    const auto unit = [&] { return random_unit(random); };
+    // Eleven planes (a full block of eight and three more): a room's axis-aligned walls, two of
+    // them at the same place facing opposite ways (ties), and tilted ones.
+    scene::Scene world;
+    world.materials.push_back({});
+    const glm::dvec3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (int i = 0; i < 6; ++i)
+        world.planes.push_back({"wall", 0, (i % 2 == 0 ? -3.0 : 3.0) * axes[i / 2], (i % 2 == 0 ? 1.0 : -1.0) * axes[i / 2],
+                                glm::dmat4(1.0)});
+    world.planes.push_back({"twin", 0, {0, -3, 0}, {0, -1, 0}, glm::dmat4(1.0)});
+    for (int i = 0; i < 4; ++i) world.planes.push_back({"tilted", 0, 2.0 * unit(), unit(), glm::dmat4(1.0)});
+    std::vector<prism::PlaneShape<Real>> planes;
+    for (const auto& plane : world.planes) planes.push_back({Vec3(plane.point), Vec3(glm::normalize(plane.normal))});
+    const Geometry geometry(world);
+    REQUIRE(geometry.instance_count() == 0);
+
+    std::size_t hits = 0, rays = 0;
+    for (int i = 0; i < 100000; ++i) {
+        prism::Ray<Real> ray{Vec3(4.0 * glm::dvec3(uniform(random), uniform(random), uniform(random))), Vec3(unit()), Real(0),
+                             prism::infinity<Real>};
+        if (i % 4 == 1) ray.t_max = Real(4 * std::abs(uniform(random)));
+        if (i % 4 == 2) ray.origin.y = Real(-3);  // on the twin walls
+        if (i % 8 == 3) ray.direction.x = Real(0);  // parallel to two walls
+        if (i % 16 == 5) ray.t_min = Real(-1);
+        for (const bool cull : {false, true}) {
+            ++rays;
+            // The loop intersect_planes replaced: each plane's own test, in order.
+            prism::Ray<Real> expected_ray = ray;
+            bool expected = false;
+            std::uint32_t expected_plane = 0;
+            for (std::size_t p = 0; p < planes.size(); ++p) {
+                Real t;
+                if (!planes[p].intersect(expected_ray, expected_ray.t_min, expected_ray.t_max, t)) continue;
+                if (cull && glm::dot(expected_ray.direction, planes[p].normal) > 0) continue;
+                expected_ray.t_max = t;
+                expected_plane = std::uint32_t(p);
+                expected = true;
+            }
+            prism::Ray<Real> found_ray = ray;
+            prism::Hit<Real> hit;
+            const bool found = cull ? geometry.template intersect<prism::BackfaceCulling::all>(found_ray, hit)
+                                    : geometry.intersect(found_ray, hit);
+            REQUIRE(found == expected);
+            CHECK(same_bits(found_ray.t_max, expected_ray.t_max));
+            if (found) {
+                ++hits;
+                CHECK(same_bits(hit.t, expected_ray.t_max));
+                CHECK(hit.object == expected_plane);
+            }
+        }
+        bool blocked = false;
+        for (const auto& plane : planes) {
+            Real t;
+            blocked |= plane.intersect(ray, ray.t_min, ray.t_max, t) && t < ray.t_max;
+        }
+        CHECK(geometry.occluded(ray) == blocked);
+    }
+    CHECK(hits > rays / 2);
 }
 
 TEST_CASE_TEMPLATE("Blinn-Phong: the power is left out only where the sum is the same without it", Real, float, double) {

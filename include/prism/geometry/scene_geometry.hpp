@@ -18,8 +18,10 @@
 #include <prism/geometry/surface_error.hpp>
 #include <prism/geometry/triangle_mesh.hpp>
 #include <prism/scene/scene.hpp>
+#include <prism/simd/pack.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -104,6 +106,14 @@ public:
             const glm::dvec3 normal =
                 glm::normalize(glm::transpose(glm::inverse(glm::dmat3(plane.transform))) * plane.normal);
             planes_.push_back({Vec3<Real>(point), Vec3<Real>(normal)});
+            if (planes_.size() % direct_width == 1) plane_blocks_.emplace_back();
+            PlaneBlock& block = plane_blocks_.back();
+            const std::size_t lane = (planes_.size() - 1) % direct_width;
+            for (int axis = 0; axis < 3; ++axis) {
+                block.point[axis][lane] = planes_.back().point[axis];
+                block.normal[axis][lane] = planes_.back().normal[axis];
+            }
+            block.lanes |= std::uint32_t(1) << lane;
             plane_materials_.push_back(std::uint32_t(plane.material));
             plane_textures_.push_back(add_texture_list(plane.textures));
         }
@@ -141,7 +151,8 @@ public:
         top_options.max_leaf_size = 1;
         if constexpr (requires { Index::build(boxes, top_options); }) top_ = Index::build(boxes, top_options);
         else top_ = Index::build(boxes);
-        choose_direct_spheres(scene);
+        choose_direct_top_level(scene);
+        choose_direct_world_meshes();
     }
 
     std::size_t instance_count() const { return instances_.size(); }
@@ -177,7 +188,7 @@ public:
     // (geometry/backface_culling.hpp).
     template <BackfaceCulling Culling = BackfaceCulling::none>
     bool intersect(Ray<Real>& ray, Hit<Real>& hit) const {
-        if (world_meshes_.empty() && !direct_spheres_.empty()) return intersect_direct<Culling>(ray, hit, false);
+        if (direct_) return intersect_direct<Culling>(ray, hit, !world_meshes_.empty() && intersect_world_leaves<Culling>(ray, hit));
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;  // made when the ray first enters a mesh
         // The merged world-space meshes first: their hit lowers t_max before the top level
@@ -198,7 +209,7 @@ public:
                 found = true;
             }
         }
-        if (!direct_spheres_.empty()) return intersect_direct<Culling>(ray, hit, found);
+        if (direct_top_) return intersect_direct<Culling>(ray, hit, found);
         if (top_objects_.empty()) return intersect_planes<Culling>(ray, hit) || found;
         const auto& order = top_.primitive_indices();
         top_.traverse_closest(traversal_ray, ray.t_min, ray.t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_max) {
@@ -219,16 +230,21 @@ public:
     // Planes are unbounded, so no index holds them: every ray tests each one (closest hit, as
     // intersect above).
     template <BackfaceCulling Culling = BackfaceCulling::none>
+    // Eight planes at a time (plane_distances); the lanes are then accepted in order as one
+    // plane after another would be, so the hit is the scalar loop's.
     bool intersect_planes(Ray<Real>& ray, Hit<Real>& hit) const {
         bool found = false;
-        for (std::size_t p = 0; p < planes_.size(); ++p) {
-            Real t;
-            if (planes_[p].intersect(ray, ray.t_min, ray.t_max, t)) {
+        for (std::size_t b = 0; b < plane_blocks_.size(); ++b) {
+            alignas(64) Real t[direct_width];
+            alignas(64) Real denominator[direct_width];
+            for (std::uint32_t lanes = plane_distances(plane_blocks_[b], ray, t, denominator); lanes != 0; lanes &= lanes - 1) {
+                const int lane = std::countr_zero(lanes);
+                if (!(t[lane] <= ray.t_max)) continue;
                 if constexpr (Culling == BackfaceCulling::all) {
-                    if (glm::dot(ray.direction, planes_[p].normal) > 0) continue;
+                    if (denominator[lane] > 0) continue;
                 }
-                ray.t_max = t;
-                hit = Hit<Real>{t, std::uint32_t(instances_.size() + p), 0, 0, 0};
+                ray.t_max = t[lane];
+                hit = Hit<Real>{t[lane], std::uint32_t(instances_.size() + b * direct_width + std::size_t(lane)), 0, 0, 0};
                 found = true;
             }
         }
@@ -237,7 +253,7 @@ public:
 
     // Whether anything lies in (ray.t_min, ray.t_max).
     bool occluded(const Ray<Real>& ray) const {
-        if (world_meshes_.empty() && !direct_spheres_.empty()) return occluded_direct(ray);
+        if (direct_) return (!world_meshes_.empty() && occluded_world_leaves(ray)) || occluded_direct(ray);
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;
         std::optional<RayBoxPrecomputed<Real>> box_ray;
@@ -247,7 +263,7 @@ public:
             if (!world_triangle_ray) world_triangle_ray.emplace(ray);
             if (index.occluded(ray, traversal_ray, *world_triangle_ray, ray.t_max)) return true;
         }
-        if (!direct_spheres_.empty()) return occluded_direct(ray);
+        if (direct_top_) return occluded_direct(ray);
         const auto& order = top_.primitive_indices();
         const bool blocked =
             !top_objects_.empty() &&
@@ -261,9 +277,11 @@ public:
     }
 
     bool occluded_by_planes(const Ray<Real>& ray) const {
-        for (const auto& plane : planes_) {
-            Real t;
-            if (plane.intersect(ray, ray.t_min, ray.t_max, t) && t < ray.t_max) return true;
+        for (const PlaneBlock& block : plane_blocks_) {
+            alignas(64) Real t[direct_width];
+            alignas(64) Real denominator[direct_width];
+            for (std::uint32_t lanes = plane_distances(block, ray, t, denominator); lanes != 0; lanes &= lanes - 1)
+                if (t[std::countr_zero(lanes)] < ray.t_max) return true;
         }
         return false;
     }
@@ -485,6 +503,13 @@ private:
             for (int c = 0; c < 8; ++c)
                 instance.world_bounds.extend(
                     Vec3<Real>(transform * glm::dvec4(glm::dvec3(object_bounds.corner(c)), 1.0)));
+            // The corners are rounded to nearest, so the box could fall inside the transformed
+            // object by half an ulp: rays through a silhouette vertex on it were lost (found by
+            // the direct test of test_small_scenes). One ulp outwards keeps it conservative.
+            for (int axis = 0; axis < 3; ++axis) {
+                instance.world_bounds.min[axis] = next_down(instance.world_bounds.min[axis]);
+                instance.world_bounds.max[axis] = next_up(instance.world_bounds.max[axis]);
+            }
         } else {
             instance.world_bounds = object_bounds;
         }
@@ -589,36 +614,92 @@ private:
         return spheres_[instance.shape].intersect(local, ray.t_min, t_max, t) && t < t_max;
     }
 
-    // A top level of a few spheres and nothing else (the course's sphere scenes of 1 to 4) is
+    // A top level of a few spheres and nothing else (the course's sphere scenes of 1 to 8) is
     // tested sphere after sphere, without the index: the traversal's prepared ray (three
     // divisions, broadcast) and its node test cost more than the spheres (hw2 mirror_room: the
     // prepared ray alone was 15% of the time). Each sphere is tested as the index's leaf tests
     // it, so the hits are the same; only two spheres hit at exactly the same distance could
     // resolve otherwise (the later one tested wins in both).
-    // Up to 4: with 5 and 6 untransformed spheres (hw1 spheres_with_plane, spheres.json) the
-    // index's one 8-wide box test was cheaper than the spheres' tests (1.04-1.05 of base's CPU
-    // time); with 2 and 4 (mirror_room, mirror_spheres) the direct test took 0.89 and 0.83.
-    static constexpr std::size_t direct_sphere_limit = 4;
-    struct DirectSphere {
+    // Up to 8, the spheres' culls in one SIMD pass (may_hit): tested one by one, 5 and 6
+    // untransformed spheres (hw1 spheres_with_plane, spheres.json) had cost more than the
+    // index's one 8-wide box test (1.04-1.05 of its CPU time, whole3).
+    static constexpr int direct_width = 8;
+    static constexpr std::size_t direct_limit = direct_width;
+    using DirectPack = simd::Pack<Real, direct_width>;
+    // Each direct object on cache lines of its own (alignas(64), so the vector's block is too):
+    // with the small heap block next to data the render threads write, hw2 simple_reflectance's
+    // shadow rays stalled on reading it at 2 threads (1.25 of base's CPU time, 0.91 at 1 thread).
+    struct alignas(64) DirectSphere {
         std::uint32_t object = 0;
         // How the ray reaches object space: unchanged, moved by `translation` (a transform that
         // only translates: the matrix product's answer, ox + tx with zero terms, bit for bit),
         // or by the instance's matrix.
         enum class Map : std::uint8_t { none, translation, matrix } map = Map::none;
         Vec3<Real> translation{0};
-        // A world-space sphere around the object, widened so that may_hit never rejects a ray
-        // the object-space test hits: it culls as the index's box did.
-        Vec3<Real> center{0};
-        Real radius_squared = 0;
+    };
+    // Up to eight planes SoA, for one SIMD pass of PlaneShape::intersect's arithmetic.
+    struct PlaneBlock {
+        alignas(64) Real point[3][direct_width] = {};
+        alignas(64) Real normal[3][direct_width] = {};
+        std::uint32_t lanes = 0;  // the planes present
     };
 
-    void choose_direct_spheres(const scene::Scene& scene) {
-        if (top_objects_.empty() || top_objects_.size() > direct_sphere_limit) return;
+    // PlaneShape::intersect for a block's planes, lane by lane with its operations in its order
+    // (the dot products as glm sums them): bit i set where plane i is met in (t_min, ...) with a
+    // t that t_max has not yet been compared with; t and the denominator (direction . normal)
+    // stored. The scalar test's shortcut for planes behind the ray only skips a division whose
+    // t would fail t > t_min >= 0 anyway, so every lane divides.
+    [[gnu::always_inline]] static std::uint32_t plane_distances(const PlaneBlock& block, const Ray<Real>& ray, Real* t,
+                                                                Real* denominator) {
+        DirectPack normal[3], along[3];
+        for (int axis = 0; axis < 3; ++axis) {
+            normal[axis] = DirectPack::load(block.normal[axis]);
+            along[axis] = DirectPack::load(block.point[axis]) - DirectPack::broadcast(ray.origin[axis]);
+        }
+        const DirectPack d = (DirectPack::broadcast(ray.direction.x) * normal[0] +
+                              DirectPack::broadcast(ray.direction.y) * normal[1]) +
+                             DirectPack::broadcast(ray.direction.z) * normal[2];
+        const DirectPack numerator = (along[0] * normal[0] + along[1] * normal[1]) + along[2] * normal[2];
+        const DirectPack distance = numerator / d;
+        d.store(denominator);
+        distance.store(t);
+        const std::uint32_t met = ((d != DirectPack::broadcast(Real(0))) & (DirectPack::broadcast(ray.t_min) < distance)).bits();
+        return met & block.lanes;
+    }
+
+    // A mesh of the top level small enough for one leaf (a transformed floor or plate of a few
+    // triangles): the ray is taken to its object space and the leaf tested there, as the
+    // instance's own index would after the top level's box test. Rays that leave the leaf's box
+    // by a face are culled in object space first, as that index's slab test rejects them;
+    // only rays the world box alone would have stopped are tested too, and they miss.
+    struct alignas(64) DirectMesh {
+        std::uint32_t object = 0;
+        typename Mesh::Leaf leaf;
+    };
+    // Around each direct sphere, lane by lane, a world-space sphere widened so that may_hit
+    // never rejects a ray the object-space test hits: it culls as the index's box did. Lanes
+    // past the last sphere are masked off.
+    struct DirectBounds {
+        alignas(64) Real center[3][direct_width] = {};
+        alignas(64) Real radius_squared[direct_width] = {};
+        std::uint32_t lanes = 0;
+    };
+
+    void choose_direct_top_level(const scene::Scene& scene) {
+        if (top_objects_.empty() || top_objects_.size() > direct_limit) return;
         const std::size_t first_sphere = scene.meshes.size() + scene.mesh_instances.size();
         std::vector<DirectSphere> chosen;
+        std::vector<DirectMesh> meshes;
+        DirectBounds bounds;
         for (const std::uint32_t object : top_objects_) {
             const Instance& instance = instances_[object];
-            if (instance.kind != Kind::sphere || instance.moving) return;
+            if (instance.moving) return;
+            if (instance.kind == Kind::mesh) {
+                const std::optional<typename Mesh::Leaf> leaf = meshes_[instance.shape].single_leaf();
+                if (!leaf) return;
+                meshes.push_back({object, *leaf});
+                continue;
+            }
             DirectSphere direct;
             direct.object = object;
             if (instance.transformed) {
@@ -638,31 +719,45 @@ private:
                 rows = std::max(rows, std::abs(linear[0][i]) + std::abs(linear[1][i]) + std::abs(linear[2][i]));
             }
             const double radius = source.radius * std::sqrt(std::min(frobenius, columns * rows)) * (1 + 1e-3);
-            direct.center = Vec3<Real>(glm::dvec3(source.transform * glm::dvec4(source.center, 1.0)));
-            direct.radius_squared = Real(radius * radius);
+            const Vec3<Real> center(glm::dvec3(source.transform * glm::dvec4(source.center, 1.0)));
+            const std::size_t lane = chosen.size();
+            for (int axis = 0; axis < 3; ++axis) bounds.center[axis][lane] = center[axis];
+            bounds.radius_squared[lane] = Real(radius * radius);
+            bounds.lanes |= std::uint32_t(1) << lane;
             chosen.push_back(direct);
         }
         direct_spheres_ = std::move(chosen);
+        direct_meshes_ = std::move(meshes);
+        direct_bounds_ = bounds;
+        direct_top_ = true;
     }
 
-    // Whether the ray may meet the object inside `sphere`: false only where it surely misses,
-    // starting outside and leaving, or passing wider than the radius (a |oc|^2 - b^2 > a r^2,
-    // no division). The rounded oc, b and products are off by at most 8 epsilon a |oc|^2 in
-    // all (the cancellation when the ray aims at the centre); the test allows twice that.
-    [[gnu::always_inline]] static bool may_hit(const DirectSphere& sphere, const Ray<Real>& ray) {
-        const Vec3<Real> oc = ray.origin - sphere.center;
-        const Real b = glm::dot(oc, ray.direction);
-        const Real distance_squared = glm::dot(oc, oc);
-        if (b >= 0 && distance_squared > sphere.radius_squared && ray.t_min >= 0) return false;
-        const Real a = glm::dot(ray.direction, ray.direction);
-        return a * distance_squared - b * b <=
-               a * (sphere.radius_squared + 16 * std::numeric_limits<Real>::epsilon() * distance_squared);
+    // Which direct spheres the ray may meet (bit i for sphere i): lane by lane, false only where
+    // it surely misses, starting outside and leaving, or passing wider than the radius
+    // (a |oc|^2 - b^2 > a r^2, no division). The rounded oc, b and products are off by at most
+    // 8 epsilon a |oc|^2 in all (the cancellation when the ray aims at the centre); the test
+    // allows twice that. Each lane computes what the scalar dot products compute, in their order.
+    [[gnu::always_inline]] std::uint32_t may_hit(const Ray<Real>& ray) const {
+        const DirectBounds& bounds = direct_bounds_;
+        DirectPack oc[3];
+        for (int axis = 0; axis < 3; ++axis)
+            oc[axis] = DirectPack::broadcast(ray.origin[axis]) - DirectPack::load(bounds.center[axis]);
+        const DirectPack dx = DirectPack::broadcast(ray.direction.x), dy = DirectPack::broadcast(ray.direction.y),
+                         dz = DirectPack::broadcast(ray.direction.z);
+        const DirectPack b = (oc[0] * dx + oc[1] * dy) + oc[2] * dz;
+        const DirectPack distance_squared = (oc[0] * oc[0] + oc[1] * oc[1]) + oc[2] * oc[2];
+        const DirectPack radius_squared = DirectPack::load(bounds.radius_squared);
+        std::uint32_t leaving = 0;
+        if (ray.t_min >= 0) leaving = ((DirectPack::broadcast(Real(0)) <= b) & (radius_squared < distance_squared)).bits();
+        const DirectPack a = DirectPack::broadcast(glm::dot(ray.direction, ray.direction));
+        const DirectPack slack = DirectPack::broadcast(16 * std::numeric_limits<Real>::epsilon());
+        const std::uint32_t near = (a * distance_squared - b * b <= a * (radius_squared + slack * distance_squared)).bits();
+        return near & ~leaving & bounds.lanes;
     }
 
     // Whether the ray meets `sphere` in (ray.t_min, t_max], tested in object space as the index's
-    // leaf tests it (to_object).
+    // leaf tests it (to_object); for the spheres may_hit lets through.
     [[gnu::always_inline]] bool direct_hit(const DirectSphere& sphere, const Ray<Real>& ray, Real t_max, Real& t) const {
-        if (!may_hit(sphere, ray)) return false;
         const Instance& instance = instances_[sphere.object];
         const SphereShape<Real>& shape = spheres_[instance.shape];
         switch (sphere.map) {
@@ -680,7 +775,8 @@ private:
     // intersect's top level and planes for direct_spheres_; `found`: a world mesh was hit.
     template <BackfaceCulling Culling>
     bool intersect_direct(Ray<Real>& ray, Hit<Real>& hit, bool found) const {
-        for (const DirectSphere& sphere : direct_spheres_) {
+        for (std::uint32_t lanes = direct_spheres_.empty() ? 0 : may_hit(ray); lanes != 0; lanes &= lanes - 1) {
+            const DirectSphere& sphere = direct_spheres_[std::size_t(std::countr_zero(lanes))];
             Real t;
             if (!direct_hit(sphere, ray, ray.t_max, t)) continue;
             ray.t_max = t;
@@ -689,15 +785,113 @@ private:
             hit.object = sphere.object;
             found = true;
         }
+        if constexpr (Mesh::packed) {
+            for (const DirectMesh& direct : direct_meshes_) {
+                const Instance& instance = instances_[direct.object];
+                const Ray<Real> local = to_object(instance, ray);
+                if (leaves_box(direct.leaf.box, local)) continue;
+                const Mesh& mesh = meshes_[instance.shape];
+                const TriangleRay triangle_ray(local);
+                const bool cull = Culling == BackfaceCulling::all || (Culling == BackfaceCulling::flat_triangles && !mesh.smooth());
+                if (cull ? mesh.template intersect_leaf<true>(local, triangle_ray, direct.leaf, ray.t_max, hit)
+                         : mesh.template intersect_leaf<false>(local, triangle_ray, direct.leaf, ray.t_max, hit)) {
+                    hit.object = direct.object;
+                    found = true;
+                }
+            }
+        }
         return intersect_planes<Culling>(ray, hit) || found;
     }
 
     bool occluded_direct(const Ray<Real>& ray) const {
-        for (const DirectSphere& sphere : direct_spheres_) {
+        for (std::uint32_t lanes = direct_spheres_.empty() ? 0 : may_hit(ray); lanes != 0; lanes &= lanes - 1) {
+            const DirectSphere& sphere = direct_spheres_[std::size_t(std::countr_zero(lanes))];
             Real t;
             if (direct_hit(sphere, ray, ray.t_max, t) && t < ray.t_max) return true;
         }
+        if constexpr (Mesh::packed) {
+            for (const DirectMesh& direct : direct_meshes_) {
+                const Instance& instance = instances_[direct.object];
+                const Ray<Real> local = to_object(instance, ray);
+                if (leaves_box(direct.leaf.box, local)) continue;
+                if (meshes_[instance.shape].occluded_leaf(local, TriangleRay(local), direct.leaf, ray.t_max)) return true;
+            }
+        }
         return occluded_by_planes(ray);
+    }
+
+    // A scene whose top level is tested without its index (direct spheres, or nothing but the
+    // world-space meshes and planes) and whose world-space indices are each one leaf (at most N
+    // triangles: the course's floors, walls and mirrors of two to six) is tested without the
+    // TraversalRay: each index's leaf directly (TriangleMesh::intersect_leaf), then the spheres
+    // and planes. The TraversalRay (three divisions, broadcast) and the root's box test were
+    // a fifth of hw1 simple_reflectance's profile (a two-triangle floor and one sphere). The
+    // hits are the index's: traversal of a single leaf tests that leaf, in the same slot order
+    // with the same t_max; only a ray whose box test the index would fail is now tested too,
+    // and the conservative box (Ize's widened exit) fails only rays that miss the triangles.
+    void choose_direct_world_meshes() {
+        if (!top_objects_.empty() && !direct_top_) return;
+        for (WorldMeshes& group : world_meshes_) {
+            const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
+            group.leaf = index.single_leaf();
+            if (!group.leaf) return;
+        }
+        direct_ = true;
+    }
+
+    // Whether the ray starts outside the box beyond one of its faces and does not move towards
+    // it (a floor's rays that start above it and go up: most shadow and reflected rays), with
+    // t_min >= 0. The index's slab test rejects every such ray without a division: the far
+    // plane's distance (face - origin) / direction is negative, or -inf for a zero direction
+    // of either sign, or the near plane's +inf, so the exit falls below the entry. (Only a
+    // distance that underflows to -0, an origin within a subnormal's width of the face, would
+    // pass that test; the ray then starts on the box and the leaf test decides, as here.)
+    [[gnu::always_inline]] static bool leaves_box(const Aabb<Real>& box, const Ray<Real>& ray) {
+        bool away = false;
+        for (int axis = 0; axis < 3; ++axis)
+            away |= (ray.origin[axis] > box.max[axis] && ray.direction[axis] >= 0) |
+                    (ray.origin[axis] < box.min[axis] && ray.direction[axis] <= 0);
+        return away && ray.t_min >= 0;
+    }
+
+    // The world-space meshes' leaves for intersect's direct path: hit or not, and hit filled as
+    // intersect's loop over the indices fills it.
+    template <BackfaceCulling Culling>
+    bool intersect_world_leaves(Ray<Real>& ray, Hit<Real>& hit) const {
+        if constexpr (Mesh::packed) {
+            std::optional<TriangleRay> triangle_ray;  // made for the first leaf the ray may reach
+            bool found = false;
+            for (const WorldMeshes& group : world_meshes_) {
+                if (leaves_box(group.leaf->box, ray)) continue;
+                if (!triangle_ray) triangle_ray.emplace(ray);
+                const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
+                const bool cull =
+                    Culling == BackfaceCulling::all || (Culling == BackfaceCulling::flat_triangles && !group.smooth);
+                const bool group_hit = cull ? index.template intersect_leaf<true>(ray, *triangle_ray, *group.leaf, ray.t_max, hit)
+                                            : index.template intersect_leaf<false>(ray, *triangle_ray, *group.leaf, ray.t_max, hit);
+                if (group_hit) {
+                    if (group.index) group.attribute(index.source_triangle(hit.primitive), hit);
+                    else hit.object = group.objects[0];
+                    found = true;
+                }
+            }
+            return found;
+        } else {
+            return false;  // single_leaf() is empty without packets: direct_ stays false
+        }
+    }
+
+    bool occluded_world_leaves(const Ray<Real>& ray) const {
+        if constexpr (Mesh::packed) {
+            std::optional<TriangleRay> triangle_ray;
+            for (const WorldMeshes& group : world_meshes_) {
+                if (leaves_box(group.leaf->box, ray)) continue;
+                if (!triangle_ray) triangle_ray.emplace(ray);
+                const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
+                if (index.occluded_leaf(ray, *triangle_ray, *group.leaf, ray.t_max)) return true;
+            }
+        }
+        return false;
     }
 
     // The merged meshes of one culling class and the index over their triangles.
@@ -708,6 +902,7 @@ private:
         bool smooth = false;        // its parts' culling class
         std::vector<std::uint32_t> objects;         // per part, its object (Hit::object)
         std::vector<std::uint32_t> first_triangle;  // per part, the number of its first triangle
+        std::optional<typename Mesh::Leaf> leaf;     // the index's one leaf, when it is one (direct_)
 
         // The hit on triangle `number` of the index (hit.primitive holds the index's slot)
         // as a hit on its own mesh: its object, its triangle there (the file's order, which
@@ -723,10 +918,16 @@ private:
     std::vector<TriangleMesh<Real, Policy>> meshes_;
     std::vector<WorldMeshes> world_meshes_;
     std::vector<std::uint32_t> top_objects_;  // the top level's primitives: the objects not merged
-    std::vector<DirectSphere> direct_spheres_;  // the top level's objects, when tested without it
+    // The top level's objects when it is tested without its index (direct_top_).
+    std::vector<DirectSphere> direct_spheres_;
+    std::vector<DirectMesh> direct_meshes_;
+    bool direct_top_ = false;
+    DirectBounds direct_bounds_;
+    bool direct_ = false;  // no TraversalRay: the top level direct, the world meshes' leaves too
     Aabb<Real> bounds_;
     std::vector<SphereShape<Real>> spheres_;
     std::vector<PlaneShape<Real>> planes_;
+    std::vector<PlaneBlock> plane_blocks_;  // planes_, eight to a block
     std::vector<std::uint32_t> plane_materials_;
     std::vector<std::uint32_t> plane_textures_;
     // Each object's texture indices; entry 0 is the empty list that untextured objects share.

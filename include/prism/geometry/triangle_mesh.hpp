@@ -19,6 +19,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <span>
 #include <type_traits>
 #include <vector>
@@ -110,6 +111,52 @@ public:
         requires requires(const Index& index) { index.enters(ray, t_min, t_max); }
     {
         return index_.enters(ray, t_min, t_max);
+    }
+
+    // The slots [first, first + count) of the one leaf that holds every triangle, when the
+    // index is a single leaf (a wide BVH over at most N triangles: a root with one child).
+    // SceneGeometry tests such a mesh's leaf directly (intersect_leaf, occluded_leaf), without
+    // the traversal ray or the root's box test that would only lead to it.
+    struct Leaf {
+        std::uint32_t first = 0, count = 0;
+        Aabb<Real> box;  // the box the root's test would test (its one child's)
+    };
+    std::optional<Leaf> single_leaf() const {
+        if constexpr (packed && requires { Index::width; }) {
+            const auto& nodes = index_.nodes();
+            if (nodes.size() != 1) return std::nullopt;
+            int leaves = 0;
+            Leaf leaf;
+            for (int i = 0; i < Index::width; ++i) {
+                if (nodes[0].count[i] == 0) continue;
+                ++leaves;
+                leaf.first = nodes[0].child[i];
+                leaf.count = nodes[0].count[i];
+                for (int axis = 0; axis < 3; ++axis) {
+                    leaf.box.min[axis] = nodes[0].bounds[axis][i];
+                    leaf.box.max[axis] = nodes[0].bounds[3 + axis][i];
+                }
+            }
+            if (leaves == 1) return leaf;
+        }
+        return std::nullopt;
+    }
+
+    // The leaf's test itself, as traversal calls it on that leaf: the same packets, slots and
+    // order, so the same hit (closest in (ray.t_min, t_max], later ties winning; t_max lowered)
+    // and the same any-hit answer (open at t_max).
+    template <bool CullBackfaces>
+    [[gnu::always_inline]] bool intersect_leaf(const Ray<Real>& ray, const TriangleRay& triangle_ray, Leaf leaf, Real& t_max,
+                                               Hit<Real>& hit) const
+        requires packed
+    {
+        return packets_.template intersect<CullBackfaces>(triangle_ray.packed_ray, ray.direction, leaf.first, leaf.count,
+                                                          ray.t_min, t_max, hit);
+    }
+    [[gnu::always_inline]] bool occluded_leaf(const Ray<Real>& ray, const TriangleRay& triangle_ray, Leaf leaf, Real t_max) const
+        requires packed
+    {
+        return packets_.occluded(triangle_ray.packed_ray, leaf.first, leaf.count, ray.t_min, t_max);
     }
 
     // Closest hit along `ray` (object space) below t_max; lowers t_max and fills t, primitive,
