@@ -36,12 +36,13 @@ public:
     using Prepared = typename Intersector::template Prepared<Real>;
     using Pack = simd::Pack<Storage, N>;
 
-    // What the packed test needs of a ray, broadcast once per ray.
+    // What the packed test needs of a ray, broadcast once per ray. Forced inline: with the
+    // direct leaf tests (TriangleMesh::intersect_leaf) as more callers, GCC moved it out of line.
     struct PackedRay {
         int kx, ky, kz;
         Pack origin[3];
         Pack sx, sy, sz;
-        explicit PackedRay(const Prepared& prepared) {
+        [[gnu::always_inline]] explicit PackedRay(const Prepared& prepared) {
             const Watertight::Prepared<Storage>& ray = watertight_ray(prepared);
             kx = ray.kx;
             ky = ray.ky;

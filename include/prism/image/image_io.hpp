@@ -125,7 +125,8 @@ inline void write_ppm(const std::filesystem::path& path, const Image& image, con
     std::vector<std::uint8_t> bytes;
     for (std::size_t y = 0; y < std::size_t(image.height) && out; y += block_rows) {
         const std::size_t rows = std::min(block_rows, std::size_t(image.height) - y);
-        const float* channels = &image.pixels[y * std::size_t(image.width)].x;  // glm's vec3: 3 packed floats
+        static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "the rows are read as packed floats");
+        const float* channels = &image.pixels[y * std::size_t(image.width)].x;
         bytes.resize(rows * row);
         for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = channel_to_8bit(channels[i]);
         out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
