@@ -196,11 +196,10 @@ public:
         bool found = false;
         std::optional<RayBoxPrecomputed<Real>> box_ray;  // made once, for the first group's box
         for (const WorldMeshes& group : world_meshes_) {
-            const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
+            const Mesh& index = index_of(group);
             if (!enters(index, ray, traversal_ray, box_ray)) continue;
             if (!world_triangle_ray) world_triangle_ray.emplace(ray);
-            const bool cull =
-                Culling == BackfaceCulling::all || (Culling == BackfaceCulling::flat_triangles && !group.smooth);
+            const bool cull = culls_back_faces(Culling, group.smooth);
             const bool group_hit = cull ? index.template intersect<true>(ray, traversal_ray, *world_triangle_ray, ray.t_max, hit)
                                         : index.template intersect<false>(ray, traversal_ray, *world_triangle_ray, ray.t_max, hit);
             if (group_hit) {
@@ -228,10 +227,9 @@ public:
     }
 
     // Planes are unbounded, so no index holds them: every ray tests each one (closest hit, as
-    // intersect above).
+    // intersect above), eight at a time (plane_distances); the lanes are then accepted in order
+    // as one plane after another would be, so the hit is the scalar loop's.
     template <BackfaceCulling Culling = BackfaceCulling::none>
-    // Eight planes at a time (plane_distances); the lanes are then accepted in order as one
-    // plane after another would be, so the hit is the scalar loop's.
     bool intersect_planes(Ray<Real>& ray, Hit<Real>& hit) const {
         bool found = false;
         for (std::size_t b = 0; b < plane_blocks_.size(); ++b) {
@@ -258,7 +256,7 @@ public:
         std::optional<TriangleRay> world_triangle_ray;
         std::optional<RayBoxPrecomputed<Real>> box_ray;
         for (const WorldMeshes& group : world_meshes_) {
-            const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
+            const Mesh& index = index_of(group);
             if (!enters(index, ray, traversal_ray, box_ray)) continue;
             if (!world_triangle_ray) world_triangle_ray.emplace(ray);
             if (index.occluded(ray, traversal_ray, *world_triangle_ray, ray.t_max)) return true;
@@ -322,8 +320,11 @@ public:
     // Whether camera rays skip object's back-facing triangles under `culling`, as intersect does.
     bool culls(std::uint32_t object, BackfaceCulling culling) const {
         const Instance& instance = instances_[object];
-        return instance.kind == Kind::mesh && (culling == BackfaceCulling::all ||
-                                               (culling == BackfaceCulling::flat_triangles && !meshes_[instance.shape].smooth()));
+        return instance.kind == Kind::mesh && culls_back_faces(culling, meshes_[instance.shape].smooth());
+    }
+    // The rule itself, for a mesh of smooth (vertex-normal) or flat shading.
+    static constexpr bool culls_back_faces(BackfaceCulling culling, bool smooth) {
+        return culling == BackfaceCulling::all || (culling == BackfaceCulling::flat_triangles && !smooth);
     }
     Aabb<Real> world_bounds(std::uint32_t object) const { return instances_[object].world_bounds; }
 
@@ -584,7 +585,7 @@ private:
                             std::optional<TriangleRay>& world_triangle_ray, Real& t_max, Hit<Real>& hit) const {
         if (instance.kind == Kind::mesh) {
             const auto& mesh = meshes_[instance.shape];
-            const bool cull = Culling == BackfaceCulling::all || (Culling == BackfaceCulling::flat_triangles && !mesh.smooth());
+            const bool cull = culls_back_faces(Culling, mesh.smooth());
             if (in_world_space(instance)) {
                 if (!world_triangle_ray) world_triangle_ray.emplace(ray);
                 return cull ? mesh.template intersect<true>(ray, traversal_ray, *world_triangle_ray, t_max, hit)
@@ -683,6 +684,12 @@ private:
         alignas(64) Real center[3][direct_width] = {};
         alignas(64) Real radius_squared[direct_width] = {};
         std::uint32_t lanes = 0;
+
+        void set(std::size_t lane, const Vec3<Real>& sphere_center, double radius) {
+            for (int axis = 0; axis < 3; ++axis) center[axis][lane] = sphere_center[axis];
+            radius_squared[lane] = Real(radius * radius);
+            lanes |= std::uint32_t(1) << lane;
+        }
     };
 
     void choose_direct_top_level(const scene::Scene& scene) {
@@ -719,11 +726,7 @@ private:
                 rows = std::max(rows, std::abs(linear[0][i]) + std::abs(linear[1][i]) + std::abs(linear[2][i]));
             }
             const double radius = source.radius * std::sqrt(std::min(frobenius, columns * rows)) * (1 + 1e-3);
-            const Vec3<Real> center(glm::dvec3(source.transform * glm::dvec4(source.center, 1.0)));
-            const std::size_t lane = chosen.size();
-            for (int axis = 0; axis < 3; ++axis) bounds.center[axis][lane] = center[axis];
-            bounds.radius_squared[lane] = Real(radius * radius);
-            bounds.lanes |= std::uint32_t(1) << lane;
+            bounds.set(chosen.size(), Vec3<Real>(glm::dvec3(source.transform * glm::dvec4(source.center, 1.0))), radius);
             chosen.push_back(direct);
         }
         // The meshes' lanes follow the spheres': a world-space sphere around each one's world
@@ -739,10 +742,7 @@ private:
             // The half diagonal, plus how far rounding moved the centre, widened as above.
             const double radius =
                 (0.5 * glm::length(high - low) + glm::length(glm::dvec3(center) - exact_center)) * (1 + 1e-3);
-            const std::size_t lane = chosen.size() + m;
-            for (int axis = 0; axis < 3; ++axis) bounds.center[axis][lane] = center[axis];
-            bounds.radius_squared[lane] = Real(radius * radius);
-            bounds.lanes |= std::uint32_t(1) << lane;
+            bounds.set(chosen.size() + m, center, radius);
         }
         direct_spheres_ = std::move(chosen);
         direct_meshes_ = std::move(meshes);
@@ -791,12 +791,28 @@ private:
         return shape.intersect(instance.to_object(ray), ray.t_min, t_max, t);
     }
 
+    // The direct objects may_hit lets through, as bits of direct_spheres_ and of direct_meshes_.
+    struct DirectLanes {
+        std::uint32_t spheres = 0, meshes = 0;
+    };
+    [[gnu::always_inline]] DirectLanes direct_lanes(const Ray<Real>& ray) const {
+        if (direct_bounds_.lanes == 0) return {};
+        const std::uint32_t may = may_hit(ray);
+        const std::size_t spheres = direct_spheres_.size();
+        return {may & ((std::uint32_t(1) << spheres) - 1), may >> spheres};
+    }
+    // A direct mesh's ray in its object space, or none where its leaf's box culls it there.
+    [[gnu::always_inline]] std::optional<Ray<Real>> direct_mesh_ray(const DirectMesh& direct, const Ray<Real>& ray) const {
+        const Ray<Real> local = to_object(instances_[direct.object], ray);
+        if (leaves_box(direct.leaf.box, local)) return std::nullopt;
+        return local;
+    }
+
     // intersect's top level and planes for direct_spheres_; `found`: a world mesh was hit.
     template <BackfaceCulling Culling>
     bool intersect_direct(Ray<Real>& ray, Hit<Real>& hit, bool found) const {
-        const std::uint32_t may = direct_bounds_.lanes == 0 ? 0 : may_hit(ray);
-        const std::uint32_t sphere_lanes = (std::uint32_t(1) << direct_spheres_.size()) - 1;
-        for (std::uint32_t lanes = may & sphere_lanes; lanes != 0; lanes &= lanes - 1) {
+        const DirectLanes may = direct_lanes(ray);
+        for (std::uint32_t lanes = may.spheres; lanes != 0; lanes &= lanes - 1) {
             const DirectSphere& sphere = direct_spheres_[std::size_t(std::countr_zero(lanes))];
             Real t;
             if (!direct_hit(sphere, ray, ray.t_max, t)) continue;
@@ -807,16 +823,15 @@ private:
             found = true;
         }
         if constexpr (Mesh::packed) {
-            for (std::uint32_t lanes = may >> direct_spheres_.size(); lanes != 0; lanes &= lanes - 1) {
+            for (std::uint32_t lanes = may.meshes; lanes != 0; lanes &= lanes - 1) {
                 const DirectMesh& direct = direct_meshes_[std::size_t(std::countr_zero(lanes))];
-                const Instance& instance = instances_[direct.object];
-                const Ray<Real> local = to_object(instance, ray);
-                if (leaves_box(direct.leaf.box, local)) continue;
-                const Mesh& mesh = meshes_[instance.shape];
-                const TriangleRay triangle_ray(local);
-                const bool cull = Culling == BackfaceCulling::all || (Culling == BackfaceCulling::flat_triangles && !mesh.smooth());
-                if (cull ? mesh.template intersect_leaf<true>(local, triangle_ray, direct.leaf, ray.t_max, hit)
-                         : mesh.template intersect_leaf<false>(local, triangle_ray, direct.leaf, ray.t_max, hit)) {
+                const std::optional<Ray<Real>> local = direct_mesh_ray(direct, ray);
+                if (!local) continue;
+                const Mesh& mesh = meshes_[instances_[direct.object].shape];
+                const TriangleRay triangle_ray(*local);
+                const bool cull = culls_back_faces(Culling, mesh.smooth());
+                if (cull ? mesh.template intersect_leaf<true>(*local, triangle_ray, direct.leaf, ray.t_max, hit)
+                         : mesh.template intersect_leaf<false>(*local, triangle_ray, direct.leaf, ray.t_max, hit)) {
                     hit.object = direct.object;
                     found = true;
                 }
@@ -826,20 +841,18 @@ private:
     }
 
     bool occluded_direct(const Ray<Real>& ray) const {
-        const std::uint32_t may = direct_bounds_.lanes == 0 ? 0 : may_hit(ray);
-        const std::uint32_t sphere_lanes = (std::uint32_t(1) << direct_spheres_.size()) - 1;
-        for (std::uint32_t lanes = may & sphere_lanes; lanes != 0; lanes &= lanes - 1) {
+        const DirectLanes may = direct_lanes(ray);
+        for (std::uint32_t lanes = may.spheres; lanes != 0; lanes &= lanes - 1) {
             const DirectSphere& sphere = direct_spheres_[std::size_t(std::countr_zero(lanes))];
             Real t;
             if (direct_hit(sphere, ray, ray.t_max, t) && t < ray.t_max) return true;
         }
         if constexpr (Mesh::packed) {
-            for (std::uint32_t lanes = may >> direct_spheres_.size(); lanes != 0; lanes &= lanes - 1) {
+            for (std::uint32_t lanes = may.meshes; lanes != 0; lanes &= lanes - 1) {
                 const DirectMesh& direct = direct_meshes_[std::size_t(std::countr_zero(lanes))];
-                const Instance& instance = instances_[direct.object];
-                const Ray<Real> local = to_object(instance, ray);
-                if (leaves_box(direct.leaf.box, local)) continue;
-                if (meshes_[instance.shape].occluded_leaf(local, TriangleRay(local), direct.leaf, ray.t_max)) return true;
+                const std::optional<Ray<Real>> local = direct_mesh_ray(direct, ray);
+                if (local && meshes_[instances_[direct.object].shape].occluded_leaf(*local, TriangleRay(*local), direct.leaf, ray.t_max))
+                    return true;
             }
         }
         return occluded_by_planes(ray);
@@ -857,7 +870,7 @@ private:
     void choose_direct_world_meshes() {
         if (!top_objects_.empty() && !direct_top_) return;
         for (WorldMeshes& group : world_meshes_) {
-            const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
+            const Mesh& index = index_of(group);
             group.leaf = index.single_leaf();
             if (!group.leaf) return;
         }
@@ -889,9 +902,8 @@ private:
             for (const WorldMeshes& group : world_meshes_) {
                 if (leaves_box(group.leaf->box, ray)) continue;
                 if (!triangle_ray) triangle_ray.emplace(ray);
-                const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
-                const bool cull =
-                    Culling == BackfaceCulling::all || (Culling == BackfaceCulling::flat_triangles && !group.smooth);
+                const Mesh& index = index_of(group);
+                const bool cull = culls_back_faces(Culling, group.smooth);
                 const bool group_hit = cull ? index.template intersect_leaf<true>(ray, *triangle_ray, *group.leaf, ray.t_max, hit)
                                             : index.template intersect_leaf<false>(ray, *triangle_ray, *group.leaf, ray.t_max, hit);
                 if (group_hit) {
@@ -912,7 +924,7 @@ private:
             for (const WorldMeshes& group : world_meshes_) {
                 if (leaves_box(group.leaf->box, ray)) continue;
                 if (!triangle_ray) triangle_ray.emplace(ray);
-                const Mesh& index = group.index ? *group.index : meshes_[group.objects[0]];
+                const Mesh& index = index_of(group);
                 if (index.occluded_leaf(ray, *triangle_ray, *group.leaf, ray.t_max)) return true;
             }
         }
@@ -939,6 +951,8 @@ private:
             hit.primitive = number - first_triangle[part];
         }
     };
+    // The index a world group is traversed through: its merged index, or its one part's own.
+    const Mesh& index_of(const WorldMeshes& group) const { return group.index ? *group.index : meshes_[group.objects[0]]; }
 
     std::vector<TriangleMesh<Real, Policy>> meshes_;
     std::vector<WorldMeshes> world_meshes_;
