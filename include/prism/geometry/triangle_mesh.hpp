@@ -18,7 +18,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <functional>
 #include <limits>
 #include <optional>
 #include <span>
@@ -68,21 +67,9 @@ public:
     // part (part 0's triangles first): for traversal only. A hit's slot names its triangle
     // through source_triangle; shading stays with each part's own (ShadingOnly) mesh, so
     // surface(), spawn_point() and the single-triangle tests are not for this mesh.
-    explicit TriangleMesh(std::span<const scene::Mesh* const> parts) : TriangleMesh(parts, BuildIndex{}) {}
-
-private:
-    struct BuildIndex {};  // Index::build, the default
-
-public:
-    // The same over an index that `build_index(count, box_of)` makes instead of Index::build
-    // (box_of(i) the box of triangle i, as Index::build takes it): how bench/intersect_bench.cpp
-    // runs prism's kernel on a tree from another builder (Embree's).
-    template <class IndexBuilder>
-        requires std::is_same_v<IndexBuilder, BuildIndex> ||
-                 std::is_invocable_r_v<Index, const IndexBuilder&, std::uint32_t, const std::function<Aabb<Real>(std::uint32_t)>&>
-    TriangleMesh(std::span<const scene::Mesh* const> parts, const IndexBuilder& build_index_with) {
+    explicit TriangleMesh(std::span<const scene::Mesh* const> parts) {
         for (const scene::Mesh* part : parts) triangle_count_ += part->triangles.size();
-        build_index(parts, build_index_with);
+        build_index(parts);
         // The packets hold the leaves' triangles: the plain copy would be read by nothing.
         if constexpr (packed) {
             triangles_.clear();
@@ -306,8 +293,7 @@ public:
 private:
     // The index over the parts' triangles (their boxes widened where Storage is wider than
     // Real), and the triangles copied into its slots, with their packets.
-    template <class IndexBuilder = BuildIndex>
-    void build_index(std::span<const scene::Mesh* const> parts, const IndexBuilder& build_index_with = {}) {
+    void build_index(std::span<const scene::Mesh* const> parts) {
         // Triangle i of the parts laid end to end: part p holds [first[p], first[p + 1]). Found
         // by search rather than kept per triangle (two pointer arrays of the triangle count).
         std::vector<std::uint32_t> first{0};
@@ -322,10 +308,7 @@ private:
             const std::size_t part = part_of(i);
             return triangle_box(*parts[part], face_of(i, part));
         };
-        if constexpr (!std::is_same_v<IndexBuilder, BuildIndex>) {
-            index_ = build_index_with(std::uint32_t(triangle_count_), std::function<Aabb<Real>(std::uint32_t)>(box_of));
-            bounds_ = index_.bounds();
-        } else if constexpr (requires { Index::build(std::uint32_t(0), box_of); }) {
+        if constexpr (requires { Index::build(std::uint32_t(0), box_of); }) {
             // The index takes the boxes as they are made; its root box is the one the loop
             // below would find (the same boxes extended in the same order).
             index_ = Index::build(std::uint32_t(triangle_count_), box_of);
