@@ -321,6 +321,104 @@ void build_prism(benchmark::State& state, const Workload& workload) {
     }
 }
 
+// Is it the tree or the kernel? prism's kernel (WideBvh<Watertight, 8>, float) on one mesh over
+// every triangle of the workload, traced without SceneGeometry's top level, with the tree built
+// by prism (prism_tree_float, WideBvhTree::build as the renderer builds it) or by Embree's
+// generic SAH builder (embree_tree_*, below): the same kernel and code path, only the tree
+// differs.
+using TreeIndex = prism::WideBvhTree<float, 8>;
+using BoxOf = std::function<prism::Aabb<float>(std::uint32_t)>;
+using TreeBuilder = TreeIndex (*)(const Workload&, std::uint32_t count, const BoxOf& box_of);
+
+// The tree `Build` makes, as the index of a policy: TriangleMesh builds it through Index::build
+// like any index, so the mesh needs no hook for it. Build gets the workload being built (its
+// triangles, for spatial splits) and keeps a copy of the tree for the statistics.
+template <TreeBuilder Build>
+struct BuiltIndex : TreeIndex {
+    BuiltIndex() = default;
+    explicit BuiltIndex(TreeIndex tree) : TreeIndex(std::move(tree)) {}
+    template <class BoxOfTriangle>
+    static BuiltIndex build(std::uint32_t count, const BoxOfTriangle& box_of) {
+        last = Build(*building, count, BoxOf(box_of));
+        return BuiltIndex(last);
+    }
+    static BuiltIndex build(std::span<const prism::Aabb<float>> boxes) {
+        return build(std::uint32_t(boxes.size()), [boxes](std::uint32_t i) { return boxes[i]; });
+    }
+    static inline const Workload* building = nullptr;
+    static inline TreeIndex last;
+};
+
+template <TreeBuilder Build>
+struct BuiltWideBvh {
+    using Intersector = prism::Watertight;
+    static constexpr int packet_width = 8;
+    template <prism::Scalar Real>
+    using Index = BuiltIndex<Build>;
+};
+
+template <TreeBuilder Build>
+using TreeMesh = prism::TriangleMesh<float, BuiltWideBvh<Build>>;
+
+template <TreeBuilder Build>
+struct BuiltTree {
+    std::unique_ptr<TreeMesh<Build>> mesh;
+    TreeIndex tree;  // a copy of the mesh's index, for the statistics
+};
+
+template <TreeBuilder Build>
+BuiltTree<Build> build_tree_mesh(const Workload& workload) {
+    std::vector<const scene::Mesh*> parts;
+    for (const scene::Mesh& mesh : workload.scene.meshes) {
+        // The mesh is traced in its object space: only right where that is the world's.
+        if (mesh.transform != glm::dmat4(1.0)) throw std::runtime_error("tree variants need untransformed meshes");
+        parts.push_back(&mesh);
+    }
+    BuiltIndex<Build>::building = &workload;
+    BuiltTree<Build> built;
+    built.mesh = std::make_unique<TreeMesh<Build>>(std::span<const scene::Mesh* const>(parts));
+    built.tree = std::move(BuiltIndex<Build>::last);
+    return built;
+}
+
+template <TreeBuilder Build>
+const BuiltTree<Build>& tree_mesh_of(const Workload& workload) {
+    static std::map<const Workload*, BuiltTree<Build>> cache;
+    BuiltTree<Build>& built = cache[&workload];
+    if (!built.mesh) built = build_tree_mesh<Build>(workload);
+    return built;
+}
+
+template <TreeBuilder Build>
+void trace_tree(const Workload& workload, const RayBatch& batch, Answers& answers) {
+    const TreeMesh<Build>& mesh = *tree_mesh_of<Build>(workload).mesh;
+    const std::vector<Ray<float>>& rays = batch.rays_float;
+    if (batch.any_hit) {
+        for (std::size_t i = 0; i < rays.size(); ++i) answers[i] = mesh.occluded(rays[i], rays[i].t_max);
+    } else {
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            float t_max = rays[i].t_max;
+            prism::Hit<float> hit;
+            answers[i] = mesh.template intersect<false>(rays[i], t_max, hit);
+        }
+    }
+}
+
+template <TreeBuilder Build>
+void build_tree(benchmark::State& state, const Workload& workload) {
+    for (auto _ : state) {
+        const BuiltTree<Build> built = build_tree_mesh<Build>(workload);
+        benchmark::DoNotOptimize(built.mesh->bounds());
+    }
+}
+
+TreeIndex prism_tree(const Workload&, std::uint32_t count, const BoxOf& box_of) { return TreeIndex::build(count, box_of); }
+
+// prism's build with twice the SAH bins (32): whether a finer binned SAH makes a better tree.
+TreeIndex prism_tree_bins32(const Workload&, std::uint32_t count, const BoxOf& box_of) {
+    return TreeIndex::build(count, box_of, {.bin_count = 32, .max_leaf_size = 8});
+}
+
 // Embree 3: the same triangles (rounded to float as prism's float variants round them), one
 // triangle geometry per mesh, default build quality; single rays (rtcIntersect1 / rtcOccluded1)
 // like prism's, with RTC_SCENE_FLAG_ROBUST off or on.
@@ -408,6 +506,185 @@ void build_embree(benchmark::State& state, const Workload& workload) {
     for (auto _ : state) rtcReleaseScene(build_embree_scene(workload.scene, Robust));
 }
 
+
+// Embree's generic builder (rtcBuildBVH, Embree's own binned SAH, and with HIGH quality its
+// spatial splits) laying out a prism WideBvhTree<float, 8>: Embree's nodes and leaves are
+// created through callbacks into a tree of its thread-local memory, then copied into the layout
+// WideBvhTree::build makes (nodes in pre-order, each leaf's range starting at a multiple of 8
+// and padded with repeats of its last primitive).
+struct EmbreeTreeSettings {
+    RTCBuildQuality quality;
+    unsigned max_leaf_size;   // at most 16, two of prism's packets, as prism's collapse allows
+    unsigned sah_block_size;  // the SAH counts a leaf's primitives in blocks of this many
+};
+
+struct EmbreeBuiltNode {
+    bool leaf;
+    unsigned count;  // children, or primitives
+};
+struct EmbreeBuiltInner {
+    EmbreeBuiltNode head;
+    void* children[8];
+    RTCBounds bounds[8];
+};
+struct EmbreeBuiltLeaf {
+    EmbreeBuiltNode head;
+    unsigned primitives[RTC_BUILD_MAX_PRIMITIVES_PER_LEAF];
+};
+
+// The triangles as the float kernel tests them (vertices rounded to float), numbered as the
+// mesh numbers them (part after part), for the spatial splits' clipping.
+struct EmbreeSplitContext {
+    std::vector<std::array<glm::dvec3, 3>> triangles;
+};
+
+// The bounds of each side of a triangle's part inside `primitive`'s box, cut at `position` on
+// axis `dimension`: the vertices on each side and the edges' crossings (in double, rounded
+// outward to float), clipped to the primitive's box, as Embree's own triangle splitter does.
+void split_triangle(const RTCBuildPrimitive* primitive, unsigned dimension, float position, RTCBounds* left, RTCBounds* right,
+                    void* user) {
+    const auto& triangle = static_cast<const EmbreeSplitContext*>(user)->triangles[primitive->primID];
+    prism::Aabb<double> sides[2];
+    for (int edge = 0; edge < 3; ++edge) {
+        const glm::dvec3& a = triangle[edge];
+        const glm::dvec3& b = triangle[(edge + 1) % 3];
+        if (a[dimension] <= position) sides[0].extend(a);
+        if (a[dimension] >= position) sides[1].extend(a);
+        if ((a[dimension] < position && b[dimension] > position) || (a[dimension] > position && b[dimension] < position)) {
+            glm::dvec3 crossing = a + (double(position) - a[dimension]) / (b[dimension] - a[dimension]) * (b - a);
+            crossing[dimension] = position;
+            sides[0].extend(crossing);
+            sides[1].extend(crossing);
+        }
+    }
+    const float lower[3] = {primitive->lower_x, primitive->lower_y, primitive->lower_z};
+    const float upper[3] = {primitive->upper_x, primitive->upper_y, primitive->upper_z};
+    RTCBounds* const out[2] = {left, right};
+    for (int side = 0; side < 2; ++side) {
+        float low[3], high[3];
+        for (int axis = 0; axis < 3; ++axis) {
+            low[axis] = std::max(lower[axis], prism::next_down(float(sides[side].min[axis])));
+            high[axis] = std::min(upper[axis], prism::next_up(float(sides[side].max[axis])));
+        }
+        if (side == 0) high[dimension] = std::min(high[dimension], position);
+        else low[dimension] = std::max(low[dimension], position);
+        *out[side] = RTCBounds{low[0], low[1], low[2], 0.0f, high[0], high[1], high[2], 0.0f};
+    }
+}
+
+struct WideLayout {
+    std::vector<prism::WideBvhNode<float, 8>> nodes;
+    std::vector<std::uint32_t> indices;
+
+    std::uint32_t new_node() {
+        prism::WideBvhNode<float, 8> node;
+        for (int row = 0; row < 6; ++row)
+            for (float& plane : node.bounds[row]) plane = row < 3 ? prism::infinity<float> : -prism::infinity<float>;
+        for (int i = 0; i < 8; ++i) node.child[i] = node.count[i] = 0;
+        nodes.push_back(node);
+        return std::uint32_t(nodes.size() - 1);
+    }
+
+    void fill(std::uint32_t wide, int slot, const void* built, const RTCBounds& box) {
+        const float low[3] = {box.lower_x, box.lower_y, box.lower_z}, high[3] = {box.upper_x, box.upper_y, box.upper_z};
+        for (int axis = 0; axis < 3; ++axis) {
+            nodes[wide].bounds[axis][slot] = low[axis];
+            nodes[wide].bounds[3 + axis][slot] = high[axis];
+        }
+        const auto* head = static_cast<const EmbreeBuiltNode*>(built);
+        if (head->leaf) {
+            const auto* leaf = static_cast<const EmbreeBuiltLeaf*>(built);
+            nodes[wide].child[slot] = std::uint32_t(indices.size());
+            nodes[wide].count[slot] = head->count;
+            indices.insert(indices.end(), leaf->primitives, leaf->primitives + head->count);
+            while (indices.size() % 8 != 0) indices.push_back(indices.back());
+        } else {
+            const std::uint32_t node = emit(static_cast<const EmbreeBuiltInner*>(built));
+            nodes[wide].child[slot] = node;
+            nodes[wide].count[slot] = 0;
+        }
+    }
+
+    std::uint32_t emit(const EmbreeBuiltInner* inner) {
+        const std::uint32_t wide = new_node();
+        for (unsigned c = 0; c < inner->head.count; ++c) fill(wide, int(c), inner->children[c], inner->bounds[c]);
+        return wide;
+    }
+};
+
+template <const EmbreeTreeSettings& Settings>
+TreeIndex embree_tree(const Workload& workload, std::uint32_t count, const BoxOf& box_of) {
+    const bool spatial = Settings.quality == RTC_BUILD_QUALITY_HIGH;
+    EmbreeSplitContext context;
+    if (spatial)
+        for (const scene::Mesh& mesh : workload.scene.meshes)
+            for (const auto& face : mesh.triangles) {
+                std::array<glm::dvec3, 3> triangle;
+                for (int v = 0; v < 3; ++v) triangle[v] = glm::dvec3(glm::vec3(mesh.positions[face[v]]));
+                context.triangles.push_back(triangle);
+            }
+    // Spatial splits add references: room for twice the triangles.
+    std::vector<RTCBuildPrimitive> primitives(spatial ? 2 * std::size_t(count) : count);
+    prism::Aabb<float> bounds;
+    for (std::uint32_t i = 0; i < count; ++i) {
+        const prism::Aabb<float> box = box_of(i);
+        bounds.extend(box);
+        primitives[i] = RTCBuildPrimitive{box.min.x, box.min.y, box.min.z, 0, box.max.x, box.max.y, box.max.z, i};
+    }
+    RTCBVH bvh = rtcNewBVH(embree_device());
+    RTCBuildArguments arguments = rtcDefaultBuildArguments();
+    arguments.buildQuality = Settings.quality;
+    arguments.maxBranchingFactor = 8;
+    arguments.maxDepth = 48;
+    arguments.sahBlockSize = Settings.sah_block_size;
+    arguments.minLeafSize = 1;
+    arguments.maxLeafSize = Settings.max_leaf_size;
+    arguments.traversalCost = 1.0f;
+    arguments.intersectionCost = 1.0f;
+    arguments.bvh = bvh;
+    arguments.primitives = primitives.data();
+    arguments.primitiveCount = count;
+    arguments.primitiveArrayCapacity = primitives.size();
+    arguments.createNode = [](RTCThreadLocalAllocator allocator, unsigned child_count, void*) -> void* {
+        auto* inner = static_cast<EmbreeBuiltInner*>(rtcThreadLocalAlloc(allocator, sizeof(EmbreeBuiltInner), 16));
+        inner->head = {false, child_count};
+        return inner;
+    };
+    arguments.setNodeChildren = [](void* node, void** children, unsigned child_count, void*) {
+        for (unsigned c = 0; c < child_count; ++c) static_cast<EmbreeBuiltInner*>(node)->children[c] = children[c];
+    };
+    arguments.setNodeBounds = [](void* node, const RTCBounds** child_bounds, unsigned child_count, void*) {
+        for (unsigned c = 0; c < child_count; ++c) static_cast<EmbreeBuiltInner*>(node)->bounds[c] = *child_bounds[c];
+    };
+    arguments.createLeaf = [](RTCThreadLocalAllocator allocator, const RTCBuildPrimitive* leaf_primitives, size_t primitive_count,
+                              void*) -> void* {
+        auto* leaf = static_cast<EmbreeBuiltLeaf*>(rtcThreadLocalAlloc(allocator, sizeof(EmbreeBuiltLeaf), 16));
+        leaf->head = {true, unsigned(primitive_count)};
+        for (size_t i = 0; i < primitive_count; ++i) leaf->primitives[i] = leaf_primitives[i].primID;
+        return leaf;
+    };
+    arguments.splitPrimitive = spatial ? &split_triangle : nullptr;
+    arguments.userPtr = &context;
+    void* root = rtcBuildBVH(&arguments);
+    if (root == nullptr) throw std::runtime_error("rtcBuildBVH failed");
+    WideLayout layout;
+    if (static_cast<const EmbreeBuiltNode*>(root)->leaf) {
+        // One leaf: a root with a single child, as WideBvhTree::build makes it.
+        layout.fill(layout.new_node(), 0, root,
+                    RTCBounds{bounds.min.x, bounds.min.y, bounds.min.z, 0.0f, bounds.max.x, bounds.max.y, bounds.max.z, 0.0f});
+    } else {
+        layout.emit(static_cast<const EmbreeBuiltInner*>(root));
+    }
+    rtcReleaseBVH(bvh);
+    return TreeIndex::from_layout(std::move(layout.nodes), std::move(layout.indices), bounds);
+}
+
+// Embree's default-like settings for prism's 8-wide packets: leaves of up to two packets, the
+// SAH counting packets (blocks of 8), as prism's collapse costs them; MEDIUM (binned SAH) and
+// HIGH (binned SAH with spatial splits); and leaves of one packet at most.
+constexpr EmbreeTreeSettings embree_medium{RTC_BUILD_QUALITY_MEDIUM, 16, 8};
+constexpr EmbreeTreeSettings embree_high{RTC_BUILD_QUALITY_HIGH, 16, 8};
+constexpr EmbreeTreeSettings embree_medium_leaf8{RTC_BUILD_QUALITY_MEDIUM, 8, 8};
 #endif  // PRISM_BENCH_WITH_EMBREE
 
 template <class Intersector>
@@ -441,6 +718,9 @@ const std::vector<Variant>& variants() {
          &build_prism<double, Wide<prism::Watertight, 8>>},
         {"wide4_double_refine", true, &trace_prism<float, Wide<prism::DoubleRefine, 4>>, nullptr},
         {"wide8_double_refine", true, &trace_prism<float, Wide<prism::DoubleRefine, 8>>, nullptr},
+        // prism's kernel on one mesh, without SceneGeometry's top level: the tree experiment's base.
+        {"prism_tree_float", true, &trace_tree<&prism_tree>, &build_tree<&prism_tree>},
+        {"prism_tree_bins32_float", true, &trace_tree<&prism_tree_bins32>, &build_tree<&prism_tree_bins32>},
         // The renderer's own choices (render/render_scene.hpp), whatever they are today: the
         // ratio lines name them so their meaning survives a change of default.
         {"default_float", true, &trace_prism<float, DefaultAcceleration<prism::Precision::single>>, nullptr},
@@ -448,6 +728,10 @@ const std::vector<Variant>& variants() {
         {"default_double_refine", true, &trace_prism<float, DefaultAcceleration<prism::Precision::double_refine>>,
          nullptr},
 #ifdef PRISM_BENCH_WITH_EMBREE
+        {"embree_tree_float", true, &trace_tree<&embree_tree<embree_medium>>, &build_tree<&embree_tree<embree_medium>>},
+        {"embree_tree_high_float", true, &trace_tree<&embree_tree<embree_high>>, &build_tree<&embree_tree<embree_high>>},
+        {"embree_tree_leaf8_float", true, &trace_tree<&embree_tree<embree_medium_leaf8>>,
+         &build_tree<&embree_tree<embree_medium_leaf8>>},
         {"embree", false, &trace_embree<false>, &build_embree<false>},
         {"embree_robust", false, &trace_embree<true>, &build_embree<true>},
 #endif
@@ -639,7 +923,7 @@ void build_scaling_benchmark(benchmark::State& state, WorkloadGetter get) {
 // clock; a ratio is taken within each round and the median over rounds is reported, with
 // its quartiles to show the noise.
 constexpr int paired_rounds = 21;
-constexpr std::array<std::pair<const char*, const char*>, 17> ratio_pairs{{
+constexpr std::array<std::pair<const char*, const char*>, 23> ratio_pairs{{
     {"default_float", "embree"},
     {"default_float", "embree_robust"},
     {"default_double", "default_float"},
@@ -657,6 +941,13 @@ constexpr std::array<std::pair<const char*, const char*>, 17> ratio_pairs{{
     {"watertight_double", "watertight_float"},
     {"watertight_float", "embree"},
     {"watertight_float", "embree_robust"},
+    // The tree experiment: the same kernel on Embree's trees and on prism's.
+    {"prism_tree_float", "default_float"},
+    {"embree_tree_float", "prism_tree_float"},
+    {"embree_tree_high_float", "prism_tree_float"},
+    {"embree_tree_leaf8_float", "prism_tree_float"},
+    {"prism_tree_bins32_float", "prism_tree_float"},
+    {"prism_tree_float", "embree"},
 }};
 
 double thread_cpu_seconds() {
@@ -744,7 +1035,7 @@ public:
                     for (const auto& [first, second] : ratio_pairs) {
                         const std::string name = std::string(first) + "/" + second;
                         if (!counters.count(name)) continue;
-                        out << "    " << std::left << std::setw(40) << (std::string(first) + " / " + second) << std::right
+                        out << "    " << std::left << std::setw(46) << (std::string(first) + " / " + second) << std::right
                             << std::setprecision(3) << counters.at(name) << "  [" << counters.at(name + "_p25") << ", "
                             << counters.at(name + "_p75") << "]\n";
                     }
@@ -829,9 +1120,112 @@ void register_benchmarks() {
     }
 }
 
+
+// ---------------------------------------------------------------------------------------------
+// The counting build (prism_tree_stats, PRISM_TRAVERSAL_STATS): each tree's shape and what the
+// kernel does per ray on it, for every batch of both workloads.
+#ifdef PRISM_TRAVERSAL_STATS
+
+struct TreeShape {
+    std::size_t inner = 0, leaves = 0, children = 0, slots = 0;
+    std::array<std::size_t, 33> leaf_sizes{};  // the last counts 32 and more
+    // The surface area heuristic as prism's collapse costs a tree: a node test and a packet
+    // test cost 1 each, times the box's area relative to the root's.
+    double sah = 0;
+    // The same with leaves costed per triangle (Embree's intersection cost per primitive), and
+    // per block of 4 (Embree's verbose statistics of its BVH8<triangle4>, for comparison).
+    double sah_triangles = 0, sah_nodes = 0, sah_blocks4 = 0;
+};
+
+void measure_shape(const TreeIndex& tree, std::uint32_t node, double area, double root_area, TreeShape& shape) {
+    const auto& wide = tree.nodes()[node];
+    ++shape.inner;
+    shape.sah += area / root_area;
+    shape.sah_triangles += area / root_area;
+    shape.sah_nodes += area / root_area;
+    for (int slot = 0; slot < 8; ++slot) {
+        prism::Aabb<float> box;
+        for (int axis = 0; axis < 3; ++axis) {
+            box.min[axis] = wide.bounds[axis][slot];
+            box.max[axis] = wide.bounds[3 + axis][slot];
+        }
+        if (box.min.x > box.max.x) continue;  // an empty slot
+        ++shape.children;
+        const double child_area = double(box.half_area());
+        if (wide.count[slot] == 0) {
+            measure_shape(tree, wide.child[slot], child_area, root_area, shape);
+        } else {
+            ++shape.leaves;
+            const std::uint32_t count = wide.count[slot];
+            ++shape.leaf_sizes[std::min<std::size_t>(count, shape.leaf_sizes.size() - 1)];
+            shape.slots += (count + 7) / 8 * 8;
+            shape.sah += child_area / root_area * double((count + 7) / 8);
+            shape.sah_triangles += child_area / root_area * double(count);
+            shape.sah_blocks4 += child_area / root_area * double((count + 3) / 4);
+        }
+    }
+}
+
+template <TreeBuilder Build>
+void print_tree_statistics(const char* name, const Workload& workload) {
+    const auto& built = tree_mesh_of<Build>(workload);
+    TreeShape shape;
+    measure_shape(built.tree, 0, double(built.tree.bounds().half_area()), double(built.tree.bounds().half_area()), shape);
+    std::printf("%s %s: %zu nodes (%.2f children each), %zu leaves (%.2f triangles each), %zu slots for %zu triangles, "
+                "SAH %.2f (per packet) %.2f (per triangle), %.1f bytes per triangle (nodes, indices, packets)\n"
+                "  SAH of the nodes %.3f, of the leaves per packet %.3f, per block of 4 %.3f\n",
+                workload.name.c_str(), name, shape.inner, double(shape.children) / double(shape.inner), shape.leaves,
+                double(workload.triangle_count) / double(shape.leaves), shape.slots, workload.triangle_count, shape.sah,
+                shape.sah_triangles, double(built.mesh->accelerator_bytes()) / double(workload.triangle_count), shape.sah_nodes,
+                shape.sah - shape.sah_nodes, shape.sah_blocks4);
+    std::printf("  leaf sizes:");
+    for (std::size_t size = 1; size < shape.leaf_sizes.size(); ++size)
+        if (shape.leaf_sizes[size] != 0) std::printf(" %zu:%zu", size, shape.leaf_sizes[size]);
+    std::printf("\n  per ray       nodes  boxes entered  leaves  packets  triangles\n");
+    for (BatchKind kind : batch_kinds) {
+        const RayBatch& batch = workload.batches[std::size_t(kind)];
+        Answers answers(batch.rays.size());
+        prism::traversal_stats = {};
+        trace_tree<Build>(workload, batch, answers);
+        const prism::TraversalStats counts = prism::traversal_stats;
+        const double rays = double(batch.rays.size());
+        std::printf("  %-10s %8.2f %14.2f %7.2f %8.2f %10.2f\n", batch_name(kind), double(counts.nodes) / rays,
+                    double(counts.boxes_entered) / rays, double(counts.leaves) / rays, double(counts.packets) / rays,
+                    double(counts.triangles) / rays);
+    }
+}
+
+int print_traversal_statistics() {
+    for (const auto& [name, getter] : workloads) {
+        const Workload& workload = getter();
+        if (!workload.error.empty()) continue;
+        print_tree_statistics<&prism_tree>("prism_tree", workload);
+        print_tree_statistics<&prism_tree_bins32>("prism_tree_bins32", workload);
+#ifdef PRISM_BENCH_WITH_EMBREE
+        print_tree_statistics<&embree_tree<embree_medium>>("embree_tree", workload);
+        print_tree_statistics<&embree_tree<embree_high>>("embree_tree_high", workload);
+        print_tree_statistics<&embree_tree<embree_medium_leaf8>>("embree_tree_leaf8", workload);
+        // Embree's own tree for its own kernel, as its verbose mode reports it.
+        std::fflush(stdout);
+        RTCDevice verbose = make_embree_device("threads=1,verbose=2");
+        rtcReleaseScene(build_embree_scene(workload.scene, false, verbose));
+        rtcReleaseDevice(verbose);
+        std::fflush(stdout);
+#endif
+    }
+    return 0;
+}
+
+#endif  // PRISM_TRAVERSAL_STATS
+
 }  // namespace
 
 int main(int argc, char** argv) {
+#ifdef PRISM_TRAVERSAL_STATS
+    (void)argc;
+    (void)argv;
+    return print_traversal_statistics();
+#endif
     register_benchmarks();
     benchmark::Initialize(&argc, argv);
     if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;

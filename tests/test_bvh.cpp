@@ -1377,3 +1377,72 @@ TEST_CASE_TEMPLATE("TriangleMesh: the caller's shared ray set-up finds the hits 
     check.template operator()<prism::WideBvh<prism::DoubleRefine, 8>>();
     check.template operator()<prism::BruteForce<prism::Watertight>>();
 }
+
+namespace {
+
+// WideBvhTree::from_layout, how the intersect bench runs the kernel on trees from other builders
+// (Embree's): a tree's own layout, adopted, traverses exactly as the tree; and a layout build()
+// never makes (every node's slots mirrored) finds the same nearest box along every ray and the
+// same any-hit answers, so traversal reads the layout it is given, in whatever slot order.
+template <class Real, int N>
+void check_tree_from_layout(const std::vector<prism::Aabb<Real>>& boxes, const std::vector<prism::Ray<Real>>& rays) {
+    using Tree = prism::WideBvhTree<Real, N>;
+    const Tree built = Tree::build(boxes);
+    const Tree adopted = Tree::from_layout(built.nodes(), built.primitive_indices(), built.bounds());
+    std::vector<prism::WideBvhNode<Real, N>> nodes = built.nodes();
+    for (auto& node : nodes) {
+        for (int i = 0; i < N / 2; ++i) {
+            for (auto& row : node.bounds) std::swap(row[i], row[N - 1 - i]);
+            std::swap(node.child[i], node.child[N - 1 - i]);
+            std::swap(node.count[i], node.count[N - 1 - i]);
+        }
+    }
+    const Tree mirrored = Tree::from_layout(nodes, built.primitive_indices(), built.bounds());
+    CHECK(mirrored.nodes().size() == built.nodes().size());
+    CHECK(mirrored.nodes()[0].child[N - 1] == built.nodes()[0].child[0]);
+    CHECK(mirrored.bounds().min == built.bounds().min);
+    CHECK(mirrored.bounds().max == built.bounds().max);
+    std::size_t adopted_differ = 0, nearest_differ = 0, any_differ = 0, hits = 0;
+    for (const prism::Ray<Real>& ray : rays) {
+        LeafLog<Real> own, adopted_log;
+        Real t_own = ray.t_max, t_adopted = ray.t_max;
+        built.traverse_closest(ray, t_own, own.closest());
+        adopted.traverse_closest(ray, t_adopted, adopted_log.closest());
+        adopted_differ += own.visits != adopted_log.visits || t_own != t_adopted;
+        // The nearest primitive box the ray enters: the same whatever order the leaves come in.
+        const prism::RayBoxPrecomputed<Real> box_ray(ray);
+        const auto nearest_box = [&](const Tree& tree) {
+            Real t_max = ray.t_max;
+            tree.traverse_closest(ray, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
+                bool found = false;
+                for (std::uint32_t slot = first; slot < first + count; ++slot) {
+                    const Real entry = prism::intersect_box(boxes[tree.primitive_indices()[slot]], box_ray, ray.t_min, t_limit,
+                                                            prism::robust_far_scale<Real>);
+                    if (entry < t_limit) {
+                        t_limit = entry;
+                        found = true;
+                    }
+                }
+                return found;
+            });
+            return t_max;
+        };
+        const Real nearest = nearest_box(built);
+        nearest_differ += nearest != nearest_box(mirrored);
+        hits += nearest != ray.t_max;
+        const auto any = [](std::uint32_t first, std::uint32_t, Real&) { return first % 2 == 1; };
+        any_differ += built.traverse_any(ray, ray.t_max, any) != mirrored.traverse_any(ray, ray.t_max, any);
+    }
+    CHECK(adopted_differ == 0);
+    CHECK(nearest_differ == 0);
+    CHECK(any_differ == 0);
+    CHECK(hits > 0);
+}
+
+}  // namespace
+
+TEST_CASE_TEMPLATE("Wide BVH from a given layout: traverses the layout it is given", Real, float, double) {
+    const auto [boxes, rays] = sphere_boxes_and_rays<Real>(31, 53);
+    check_tree_from_layout<Real, 4>(boxes, rays);
+    check_tree_from_layout<Real, 8>(boxes, rays);
+}

@@ -33,6 +33,25 @@
 #include <type_traits>
 #include <vector>
 
+// Traversal statistics (nodes tested, child boxes entered, leaves, packets and triangles tested)
+// for bench/intersect_bench.cpp's counting build, which defines PRISM_TRAVERSAL_STATS; without
+// it the counts are not compiled at all, so the kernel is the same code.
+#ifdef PRISM_TRAVERSAL_STATS
+namespace prism {
+struct TraversalStats {
+    std::uint64_t nodes = 0, boxes_entered = 0, leaves = 0, packets = 0, triangles = 0;
+};
+inline thread_local TraversalStats traversal_stats;
+}  // namespace prism
+#define PRISM_COUNT_NODE(hits) (++::prism::traversal_stats.nodes, ::prism::traversal_stats.boxes_entered += std::popcount(hits))
+#define PRISM_COUNT_LEAF(count, n)                                            \
+    (++::prism::traversal_stats.leaves, ::prism::traversal_stats.packets += ((count) + (n) - 1) / (n), \
+     ::prism::traversal_stats.triangles += (count))
+#else
+#define PRISM_COUNT_NODE(hits) ((void)0)
+#define PRISM_COUNT_LEAF(count, n) ((void)0)
+#endif
+
 namespace prism {
 
 template <Scalar Real, int N>
@@ -94,6 +113,19 @@ public:
             collapser.collapse(0);
         }
         tree.primitive_indices_.shrink_to_fit();
+        return tree;
+    }
+
+    // A tree laid out elsewhere, exactly as build() lays its own out (root at node 0, leaf ranges
+    // starting at multiples of N and padded with repeats): bench/intersect_bench.cpp runs this
+    // kernel on trees built by Embree's builder, to tell the tree's share of the time from the
+    // kernel's.
+    static WideBvhTree from_layout(std::vector<WideBvhNode<Real, N>> nodes, std::vector<std::uint32_t> primitive_indices,
+                                   Aabb<Real> bounds) {
+        WideBvhTree tree;
+        tree.nodes_ = std::move(nodes);
+        tree.primitive_indices_ = std::move(primitive_indices);
+        tree.bounds_ = bounds;
         return tree;
     }
 
@@ -229,6 +261,7 @@ private:
             simd::prefetch(node);
             Pack entry_distances;
             std::uint32_t hits = enter(node, slabs, t_min, t_max, entry_distances).bits();
+            PRISM_COUNT_NODE(hits);
             bool descend = false;
             if (hits != 0 && (hits & (hits - 1)) == 0) {
                 // One child entered, the common case deep in the tree: no stack, no sort.
@@ -237,6 +270,7 @@ private:
                     current = node.child[i];
                     continue;
                 }
+                PRISM_COUNT_LEAF(node.count[i], N);
                 if (leaf(node.child[i], node.count[i], t_max)) {
                     found = true;
                     if constexpr (AnyHit) return true;
@@ -253,7 +287,7 @@ private:
                     if (node.count[i] == 0) {
                         inner |= std::uint32_t(1) << i;
                         simd::prefetch(nodes_[node.child[i]]);
-                    } else if (leaf(node.child[i], node.count[i], t_max)) {
+                    } else if (PRISM_COUNT_LEAF(node.count[i], N), leaf(node.child[i], node.count[i], t_max)) {
                         return true;
                     }
                 }
@@ -322,6 +356,7 @@ private:
                     descend = true;
                     break;
                 }
+                PRISM_COUNT_LEAF(entry.count, N);
                 if (leaf(entry.child, entry.count, t_max)) {
                     found = true;
                     if constexpr (AnyHit) return true;
