@@ -281,7 +281,7 @@ private:
             Vec3<Real> specular = material.specular * Real(0);
             if ((material.specular != Vec3<Real>(0) || !(cos_half <= 1) || !(material.phong_exponent >= 0)) &&
                 !blinn_phong_power_negligible(material, cos_half, diffuse))
-                specular = material.specular * std::pow(cos_half, material.phong_exponent);
+                specular = material.specular * blinn_phong_power(cos_half, material.phong_exponent);
             color += (diffuse + specular) * sample.radiance;
         });
         return color;
