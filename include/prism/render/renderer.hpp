@@ -12,13 +12,13 @@
 #include <prism/io/limits.hpp>
 #include <prism/light/environment_light.hpp>
 #include <prism/render/config.hpp>
+#include <prism/render/stored_whole.hpp>
 #include <prism/texture/texture_set.hpp>
 
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
 
 #include <cstdint>
-#include <cstring>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -125,26 +125,6 @@ private:
             weights += weight;
         }
         return glm::vec3(sum / weights);
-    }
-
-    // The camera ray reaches trace through memory (a Ray is passed on the stack) and is copied
-    // there with one 32-byte load. Written field by field as the camera computes it, the ray's
-    // first 32 bytes could not be forwarded to that load from the narrower stores, which it
-    // waited for to reach the cache: a quarter of the per-pixel samples of hw1 simple.json and
-    // simple_shading, a third of ocornellbox's. Gathered into one vector, they are one store.
-    // Float rays (36 bytes) only; the same bits either way.
-    static Ray<Real> stored_whole(const Ray<Real>& ray) {
-        if constexpr (std::is_same_v<Real, float> && sizeof(Ray<float>) == 9 * sizeof(float)) {
-            typedef float Lanes __attribute__((vector_size(32)));
-            const Lanes lanes = {ray.origin.x,    ray.origin.y,    ray.origin.z, ray.direction.x,
-                                 ray.direction.y, ray.direction.z, ray.t_min,    ray.t_max};
-            Ray<Real> whole;
-            std::memcpy(static_cast<void*>(&whole), &lanes, sizeof(lanes));
-            whole.time = ray.time;
-            return whole;
-        } else {
-            return ray;
-        }
     }
 
     // A scene built in code meets the limits the loaders hold files to (io/limits.hpp): the ray
