@@ -40,8 +40,9 @@ enum class RayOffset {
 // stay in registers for stored_whole (render/stored_whole.hpp): called out of line, it answered
 // through memory, and the copy of that answer into trace's argument waited for its stores.
 template <Scalar Real, class Geometry>
-[[gnu::always_inline]] inline Ray<Real> leaving_ray(const Geometry& geometry, RayOffset offset, Real epsilon, const SurfacePoint<Real>& point,
-                      const Vec3<Real>& normal, const Vec3<Real>& direction, Real time) {
+[[gnu::always_inline]] inline Ray<Real> leaving_ray(const Geometry& geometry, RayOffset offset, Real epsilon,
+                                                    const SurfacePoint<Real>& point, const Vec3<Real>& normal,
+                                                    const Vec3<Real>& direction, Real time) {
     Ray<Real> ray{Vec3<Real>(0), direction, Real(0), infinity<Real>, time};
     if (offset == RayOffset::error_bound) {
         ray.origin = geometry.spawn_origin(point, direction);
