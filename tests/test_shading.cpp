@@ -6,11 +6,15 @@
 #include <prism/material/fresnel.hpp>
 #include <prism/render/config.hpp>
 #include <prism/render/renderer.hpp>
+#include <prism/render/stored_whole.hpp>
 
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <complex>
+#include <cstring>
+#include <limits>
+#include <random>
 #include <type_traits>
 
 namespace {
@@ -408,4 +412,35 @@ TEST_CASE_TEMPLATE("Renderer: a scene built in code is held to the loaders' limi
     CHECK_THROWS_WITH_AS(renderer.render(camera, 2, 2), doctest::Contains("samples per pixel"), std::invalid_argument);
     camera.num_samples = 1;
     CHECK(renderer.render(camera, 2, 2).pixels.size() == 4);
+}
+
+TEST_CASE_TEMPLATE("stored_whole hands on the same ray, bit for bit", Real, float, double) {
+    // Every field in its place: a lane out of order (origin and direction swapped, t_min and
+    // t_max, the time left out) changes a field below.
+    const auto same = [](Real a, Real b) { return std::memcmp(&a, &b, sizeof(Real)) == 0; };
+    const auto check = [&](const prism::Ray<Real>& ray) {
+        const prism::Ray<Real> whole = prism::stored_whole(ray);
+        for (int axis = 0; axis < 3; ++axis) {
+            CHECK(same(whole.origin[axis], ray.origin[axis]));
+            CHECK(same(whole.direction[axis], ray.direction[axis]));
+        }
+        CHECK(same(whole.t_min, ray.t_min));
+        CHECK(same(whole.t_max, ray.t_max));
+        CHECK(same(whole.time, ray.time));
+    };
+    std::mt19937 random(21);
+    std::uniform_real_distribution<double> uniform(-100, 100);
+    for (int i = 0; i < 1000; ++i) {
+        prism::Ray<Real> ray;
+        ray.origin = prism::Vec3<Real>(Real(uniform(random)), Real(uniform(random)), Real(uniform(random)));
+        ray.direction = prism::Vec3<Real>(Real(uniform(random)), Real(uniform(random)), Real(uniform(random)));
+        ray.t_min = Real(uniform(random));
+        ray.t_max = Real(uniform(random));
+        ray.time = Real(uniform(random));
+        check(ray);
+    }
+    // Signed zeros, infinities and NaNs pass as they are.
+    const Real nan = std::numeric_limits<Real>::quiet_NaN();
+    check({prism::Vec3<Real>(Real(-0.0), Real(0), nan), prism::Vec3<Real>(Real(1), Real(-0.0), Real(0)), Real(-0.0),
+           std::numeric_limits<Real>::infinity(), nan});
 }

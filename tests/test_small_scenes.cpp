@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -404,4 +405,23 @@ TEST_CASE_TEMPLATE("Blinn-Phong: the power is left out only where the sum is the
         const prism::Material<Real> material(description);
         CHECK_FALSE(prism::blinn_phong_power_negligible(material, Real(0), Vec3(1)));
     }
+}
+
+TEST_CASE_TEMPLATE("Blinn-Phong: the power of exponent 1 is std::pow's, bit for bit", Real, float, double) {
+    // The shortcut returns the cosine itself; std::pow(x, 1) must be x for the images to stay.
+    std::mt19937 random(12);
+    std::uniform_real_distribution<double> uniform(0, 1);
+    const auto check = [](Real x) {
+        CAPTURE(x);
+        CHECK(same_bits(prism::blinn_phong_power(x, Real(1)), Real(std::pow(x, Real(1)))));
+        // Other exponents are std::pow itself.
+        for (const Real exponent : {Real(0), Real(0.5), Real(3), Real(10), Real(100), Real(300)})
+            CHECK(same_bits(prism::blinn_phong_power(x, exponent), Real(std::pow(x, exponent))));
+    };
+    for (const Real x : {Real(0), Real(1), std::nextafter(Real(1), Real(2)), std::nextafter(Real(1), Real(0)),
+                         std::numeric_limits<Real>::denorm_min(), std::numeric_limits<Real>::min(), Real(1e-30)})
+        check(x);
+    for (int i = 0; i < 100000; ++i) check(Real(uniform(random)));
+    // A NaN cosine (a NaN half vector) stays NaN, as std::pow leaves it.
+    CHECK(std::isnan(prism::blinn_phong_power(std::numeric_limits<Real>::quiet_NaN(), Real(1))));
 }

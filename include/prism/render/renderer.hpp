@@ -12,6 +12,7 @@
 #include <prism/io/limits.hpp>
 #include <prism/light/environment_light.hpp>
 #include <prism/render/config.hpp>
+#include <prism/render/stored_whole.hpp>
 #include <prism/texture/texture_set.hpp>
 
 #include <tbb/blocked_range2d.h>
@@ -117,7 +118,8 @@ private:
         Vec3<Real> sum(0);
         Real weights = 0;
         for (const CameraSample<Real>& sample : drawn) {
-            const Ray<Real> ray = lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time);
+            const Ray<Real> ray =
+                stored_whole(lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time));
             const Real weight = count == 1 ? Real(1) : filter_weight(filter, sample.pixel);
             sum += weight * integrator_.radiance(ray, path);
             weights += weight;

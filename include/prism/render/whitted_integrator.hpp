@@ -13,6 +13,7 @@
 #include <prism/material/fresnel.hpp>
 #include <prism/material/material.hpp>
 #include <prism/render/integrator.hpp>
+#include <prism/render/stored_whole.hpp>
 #include <prism/sampling/random.hpp>
 #include <prism/texture/mipmap.hpp>
 
@@ -35,10 +36,13 @@ enum class RayOffset {
 
 // The ray leaving `point` along `direction`, by `offset`; `normal` is the shading normal facing
 // the incoming ray (the scene-epsilon mode offsets along it, to the side the ray leaves by).
-// Both integrators spawn their secondary and shadow rays through it.
+// Both integrators spawn their secondary and shadow rays through it. Inlined, so that its fields
+// stay in registers for stored_whole (render/stored_whole.hpp): called out of line, it answered
+// through memory, and the copy of that answer into trace's argument waited for its stores.
 template <Scalar Real, class Geometry>
-Ray<Real> leaving_ray(const Geometry& geometry, RayOffset offset, Real epsilon, const SurfacePoint<Real>& point,
-                      const Vec3<Real>& normal, const Vec3<Real>& direction, Real time) {
+[[gnu::always_inline]] inline Ray<Real> leaving_ray(const Geometry& geometry, RayOffset offset, Real epsilon,
+                                                    const SurfacePoint<Real>& point, const Vec3<Real>& normal,
+                                                    const Vec3<Real>& direction, Real time) {
     Ray<Real> ray{Vec3<Real>(0), direction, Real(0), infinity<Real>, time};
     if (offset == RayOffset::error_bound) {
         ray.origin = geometry.spawn_origin(point, direction);
@@ -168,7 +172,7 @@ private:
             const Real cos_incident = -glm::dot(d, normal);
             Vec3<Real> reflected = d + 2 * cos_incident * normal;
             if (material.roughness > 0) reflected = perturb(reflected, material.roughness, random.uniform2<Real>());
-            const Ray<Real> reflection = leaving(point, normal, reflected, ray.time);
+            const Ray<Real> reflection = stored_whole(leaving(point, normal, reflected, ray.time));
             switch (material.type) {
                 case MaterialType::blinn_phong: break;
                 case MaterialType::mirror:
@@ -281,7 +285,7 @@ private:
             Vec3<Real> specular = material.specular * Real(0);
             if ((material.specular != Vec3<Real>(0) || !(cos_half <= 1) || !(material.phong_exponent >= 0)) &&
                 !blinn_phong_power_negligible(material, cos_half, diffuse))
-                specular = material.specular * std::pow(cos_half, material.phong_exponent);
+                specular = material.specular * blinn_phong_power(cos_half, material.phong_exponent);
             color += (diffuse + specular) * sample.radiance;
         });
         return color;
@@ -300,7 +304,7 @@ private:
         Vec3<Real> transmitted = unit_vector(ratio * d + (ratio * cos_incident - cos_transmitted) * normal);
         Random& random = path.random;
         if (material.roughness > 0) transmitted = perturb(transmitted, material.roughness, random.uniform2<Real>());
-        const Ray<Real> refraction = leaving(point, normal, transmitted, reflection.time);
+        const Ray<Real> refraction = stored_whole(leaving(point, normal, transmitted, reflection.time));
         Vec3<Real> through = (1 - fresnel) * trace(refraction, depth + 1, path, travelled);
         // Pre-2020 scenes describe glass by a Transparency colour that filters what passes.
         if (material.transparency != Vec3<Real>(0)) through *= material.transparency;
