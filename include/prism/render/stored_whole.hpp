@@ -18,6 +18,7 @@ namespace prism {
 // The same ray, bit for bit. Float rays (36 bytes) only; double ones are returned as they are.
 template <Scalar Real>
 [[gnu::always_inline]] inline Ray<Real> stored_whole(const Ray<Real>& ray) {
+#if defined(__GNUC__) || defined(__clang__)  // vector extensions; elsewhere the ray as it is
     if constexpr (std::is_same_v<Real, float> && sizeof(Ray<float>) == 9 * sizeof(float)) {
         typedef float Lanes __attribute__((vector_size(32)));
         const Lanes lanes = {ray.origin.x,    ray.origin.y,    ray.origin.z, ray.direction.x,
@@ -29,6 +30,9 @@ template <Scalar Real>
     } else {
         return ray;
     }
+#else
+    return ray;
+#endif
 }
 
 }  // namespace prism
