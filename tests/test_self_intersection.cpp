@@ -425,6 +425,63 @@ TEST_CASE_TEMPLATE("InstanceTransforms: the residual bounds |A M - I|", Real, fl
     }
 }
 
+// round_trip: K |o| + k, precomputed, against the bound it stands for (the sum of the residual,
+// the way out's error carried through |A| and the way back's rounding, summed term by term in
+// long double from the stored entries), and against real round trips of points through the
+// rounded matrices: out in pbrt's order, back in GLM's order and in the reverse one.
+TEST_CASE_TEMPLATE("InstanceTransforms: round_trip bounds a point's way to world space and back", Real, float, double) {
+    using Vec3 = prism::Vec3<Real>;
+    std::mt19937_64 rng(29);
+    const Wide g3 = Wide(prism::gamma<Real>(3)), g4 = Wide(prism::gamma<Real>(4));
+    long trips = 0;
+    Wide largest_share = 0;  // of the bound that a round trip used
+    for (int i = 0; i < 2000; ++i) {
+        const glm::dmat4 transform =
+            prism::translation(glm::dvec3(random_sign(rng) * log_uniform(rng, -3, 5), random_sign(rng) * log_uniform(rng, -3, 5),
+                                          random_sign(rng) * log_uniform(rng, -3, 5))) *
+            prism::rotation(360 * std::uniform_real_distribution<double>()(rng), random_unit_vector(rng)) *
+            prism::scaling(glm::dvec3(log_uniform(rng, -2, 2), log_uniform(rng, -2, 2), log_uniform(rng, -2, 2)));
+        const prism::InstanceTransforms<Real> instance(transform);
+        const prism::Mat4<Real>& m = instance.object_to_world;
+        const prism::Mat4<Real>& a = instance.world_to_object;
+        for (int j = 0; j < 50; ++j) {
+            Vec3 o;
+            for (int axis = 0; axis < 3; ++axis) o[axis] = Real(random_sign(rng) * log_uniform(rng, -4, 4));
+            const Vec3 magnitude = glm::abs(o);
+            const Vec3 bound = instance.round_trip(magnitude);
+            for (int row = 0; row < 3; ++row) {
+                Wide stands_for = Wide(instance.residual[3][row]);
+                for (int k = 0; k < 3; ++k) stands_for += Wide(instance.residual[k][row]) * Wide(magnitude[k]);
+                for (int k = 0; k < 3; ++k) {
+                    Wide through = std::abs(Wide(m[3][k]));  // (|M| |o| + |t_M|)[k]
+                    for (int l = 0; l < 3; ++l) through += std::abs(Wide(m[l][k])) * Wide(magnitude[l]);
+                    stands_for += std::abs(Wide(a[k][row])) * (g3 + g4 * (1 + g3)) * through;
+                }
+                stands_for += g4 * std::abs(Wide(a[3][row]));
+                REQUIRE(Wide(bound[row]) >= stands_for);
+                // Not loose either: the widening for the bound's own roundings is a few ulps and
+                // the 2^-30 that covers the double sums.
+                REQUIRE(Wide(bound[row]) <= stands_for * (1 + 64 * Wide(prism::unit_roundoff<Real>)) * (1 + 0x1p-29L));
+            }
+            const Vec3 w = prism::transform_point(m, o);
+            const Vec3 back_glm = Vec3(a * prism::Vec4<Real>(w, Real(1)));
+            Vec3 back_reversed;
+            for (int row = 0; row < 3; ++row)
+                back_reversed[row] = ((a[3][row] + a[2][row] * w.z) + a[1][row] * w.y) + a[0][row] * w.x;
+            for (const Vec3& back : {back_glm, back_reversed}) {
+                ++trips;
+                for (int axis = 0; axis < 3; ++axis) {
+                    const Wide moved = std::abs(Wide(back[axis]) - Wide(o[axis]));
+                    REQUIRE(moved <= Wide(bound[axis]));
+                    largest_share = std::max(largest_share, moved / Wide(bound[axis]));
+                }
+            }
+        }
+    }
+    MESSAGE(trips, " round trips; the largest took ", double(largest_share), " of its bound");
+    CHECK(largest_share > 0);
+}
+
 namespace {
 
 // Rounds each coordinate to Real and back, so the double scene holds a mesh exact in Real. The

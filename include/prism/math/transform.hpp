@@ -33,9 +33,16 @@ inline glm::dmat4 composite_from_row_major(const std::array<double, 16>& rows) {
 }
 
 // The transforms are affine, so the homogeneous coordinate stays 1 and needs no division.
+// Each coordinate is summed as (m0 x + m1 y) + (m2 z + t): GLM's order for matrix * vec4(p, 1)
+// (its m3 * 1 is exact), so the bits are GLM's, and pbrt's order, whose gamma(3) rounding bound
+// geometry/surface_error.hpp relies on. Written out rather than through GLM so that it inlines:
+// GCC left GLM's product out of line on the spawn and hit-point paths of instanced scenes.
 template <Scalar Real>
-Vec3<Real> transform_point(const Mat4<Real>& matrix, const Vec3<Real>& point) {
-    return Vec3<Real>(matrix * Vec4<Real>(point, Real(1)));
+[[gnu::always_inline]] inline Vec3<Real> transform_point(const Mat4<Real>& matrix, const Vec3<Real>& point) {
+    Vec3<Real> result;
+    for (int row = 0; row < 3; ++row)
+        result[row] = (matrix[0][row] * point.x + matrix[1][row] * point.y) + (matrix[2][row] * point.z + matrix[3][row]);
+    return result;
 }
 
 // Directions (gaze, up, ray directions, tangents) ignore the translation. Not renormalised: a
