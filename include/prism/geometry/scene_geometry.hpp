@@ -17,6 +17,7 @@
 #include <prism/geometry/sphere.hpp>
 #include <prism/geometry/surface_error.hpp>
 #include <prism/geometry/triangle_mesh.hpp>
+#include <prism/math/transform.hpp>
 #include <prism/scene/scene.hpp>
 #include <prism/simd/pack.hpp>
 
@@ -383,11 +384,11 @@ public:
             point.texture_position = point.position;
         }
         if (instance.transformed) {
-            geometric_normal = glm::normalize(instance.normal_to_world * geometric_normal);
-            shading_normal = glm::normalize(instance.normal_to_world * shading_normal);
+            geometric_normal = glm::normalize(transform_normal(instance.normal_to_world, geometric_normal));
+            shading_normal = glm::normalize(transform_normal(instance.normal_to_world, shading_normal));
             // Tangents are directions on the surface: they map by the linear part itself.
-            point.dpdu = instance.object_to_world_linear * point.dpdu;
-            point.dpdv = instance.object_to_world_linear * point.dpdv;
+            point.dpdu = transform_direction(instance.object_to_world_linear, point.dpdu);
+            point.dpdv = transform_direction(instance.object_to_world_linear, point.dpdv);
         }
         point.geometric_normal = geometric_normal;
         point.shading_normal = shading_normal;
@@ -427,7 +428,7 @@ public:
         if (point.object >= instances_.size()) return glm::dot(direction, point.object_normal) < 0;
         const Instance& instance = instances_[point.object];
         int side = instance.transformed
-                       ? glm::dot(Mat3<Real>(transforms_[instance.transform].world_to_object) * direction,
+                       ? glm::dot(transform_direction(transforms_[instance.transform].world_to_object, direction),
                                   point.object_normal) < 0
                        : glm::dot(direction, point.object_normal) < 0;
         if constexpr (MotionBlur) {
@@ -458,10 +459,11 @@ private:
         Vec3<Real> motion{0};
         Aabb<Real> world_bounds;
 
-        Vec3<Real> to_object(const Vec3<Real>& p) const { return Vec3<Real>(world_to_object * Vec4<Real>(p, 1)); }
+        Vec3<Real> to_object(const Vec3<Real>& p) const { return transform_point(world_to_object, p); }
         // The direction is transformed but not renormalised, so t means the same in both spaces.
         Ray<Real> to_object(const Ray<Real>& ray) const {
-            return {to_object(ray.origin), world_to_object_linear * ray.direction, ray.t_min, ray.t_max, ray.time};
+            return {to_object(ray.origin), transform_direction(world_to_object_linear, ray.direction), ray.t_min, ray.t_max,
+                    ray.time};
         }
     };
 

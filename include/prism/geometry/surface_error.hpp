@@ -242,7 +242,7 @@ struct InstanceTransforms {
 template <Scalar Real>
 Vec3<Real> offset_ray_origin(const InstanceTransforms<Real>& instance, const PointWithError<Real>& object_point,
                              const Vec3<Real>& object_normal, const Vec3<Real>& world_direction) {
-    const Vec3<Real> object_direction = Mat3<Real>(instance.world_to_object) * world_direction;
+    const Vec3<Real> object_direction = transform_direction(instance.world_to_object, world_direction);
     // `magnitude` bounds |o|, the object-space origin, which the round-trip bound grows with.
     // It starts at the hit point's box; if the offset carries the origin past it, it is widened
     // by twice that offset and the bound recomputed. The offset grows with |o| only by a factor

@@ -45,11 +45,24 @@ template <Scalar Real>
     return result;
 }
 
+// A 3x3 matrix applied to a vector, summed as (m0 x + m1 y) + m2 z: GLM's order and bits,
+// written out to inline for the same reason as transform_point.
+template <Scalar Real>
+[[gnu::always_inline]] inline Vec3<Real> transform_direction(const Mat3<Real>& matrix, const Vec3<Real>& direction) {
+    Vec3<Real> result;
+    for (int row = 0; row < 3; ++row)
+        result[row] = matrix[0][row] * direction.x + matrix[1][row] * direction.y + matrix[2][row] * direction.z;
+    return result;
+}
+
 // Directions (gaze, up, ray directions, tangents) ignore the translation. Not renormalised: a
 // ray direction scaled with the object keeps its parameter t meaning the same distance.
 template <Scalar Real>
-Vec3<Real> transform_direction(const Mat4<Real>& matrix, const Vec3<Real>& direction) {
-    return Mat3<Real>(matrix) * direction;
+[[gnu::always_inline]] inline Vec3<Real> transform_direction(const Mat4<Real>& matrix, const Vec3<Real>& direction) {
+    Vec3<Real> result;
+    for (int row = 0; row < 3; ++row)
+        result[row] = matrix[0][row] * direction.x + matrix[1][row] * direction.y + matrix[2][row] * direction.z;
+    return result;
 }
 
 // The inverse transpose of the upper 3x3: it keeps normals perpendicular to transformed tangents
@@ -61,8 +74,8 @@ Mat3<Real> normal_matrix(const Mat4<Real>& matrix) {
 
 // Not renormalised, as the caller usually normalises after interpolation anyway.
 template <Scalar Real>
-Vec3<Real> transform_normal(const Mat3<Real>& inverse_transpose, const Vec3<Real>& normal) {
-    return inverse_transpose * normal;
+[[gnu::always_inline]] inline Vec3<Real> transform_normal(const Mat3<Real>& inverse_transpose, const Vec3<Real>& normal) {
+    return transform_direction(inverse_transpose, normal);
 }
 
 // For one normal: inverts the matrix on every call.
