@@ -548,7 +548,8 @@ private:
     }
 
     // The ray in the instance's object space, at the ray's instant for moving instances.
-    Ray<Real> to_object(const Instance& instance, const Ray<Real>& ray) const {
+    // Forced inline as Instance::to_object is (the top level's leaf and the direct meshes call it).
+    [[gnu::always_inline]] Ray<Real> to_object(const Instance& instance, const Ray<Real>& ray) const {
         if constexpr (MotionBlur) {
             if (instance.moving) {
                 Ray<Real> unmoved = ray;
