@@ -25,6 +25,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <optional>
 #include <span>
@@ -384,11 +385,18 @@ public:
             point.texture_position = point.position;
         }
         if (instance.transformed) {
+            // Spheres and flat meshes shade with the geometric normal itself (the same bits):
+            // it is mapped and normalised once.
+            const bool one_normal = std::memcmp(&geometric_normal, &shading_normal, sizeof(geometric_normal)) == 0;
             geometric_normal = glm::normalize(transform_normal(instance.normal_to_world, geometric_normal));
-            shading_normal = glm::normalize(transform_normal(instance.normal_to_world, shading_normal));
-            // Tangents are directions on the surface: they map by the linear part itself.
-            point.dpdu = transform_direction(instance.object_to_world_linear, point.dpdu);
-            point.dpdv = transform_direction(instance.object_to_world_linear, point.dpdv);
+            shading_normal = one_normal ? geometric_normal
+                                        : glm::normalize(transform_normal(instance.normal_to_world, shading_normal));
+            // Tangents are directions on the surface: they map by the linear part itself. An
+            // unparametrised sphere has none (zero, and read by nothing).
+            if (Parametrised || instance.kind == Kind::mesh) {
+                point.dpdu = transform_direction(instance.object_to_world_linear, point.dpdu);
+                point.dpdv = transform_direction(instance.object_to_world_linear, point.dpdv);
+            }
         }
         point.geometric_normal = geometric_normal;
         point.shading_normal = shading_normal;
