@@ -57,6 +57,14 @@ glm::dvec3 random_unit_vector(std::mt19937_64& rng) {
     }
 }
 
+// An instance's transform: translation up to 1e5, a rotation, scales 0.01..100 per axis.
+glm::dmat4 random_instance_transform(std::mt19937_64& rng) {
+    return prism::translation(glm::dvec3(random_sign(rng) * log_uniform(rng, -3, 5), random_sign(rng) * log_uniform(rng, -3, 5),
+                                         random_sign(rng) * log_uniform(rng, -3, 5))) *
+           prism::rotation(360 * std::uniform_real_distribution<double>()(rng), random_unit_vector(rng)) *
+           prism::scaling(glm::dvec3(log_uniform(rng, -2, 2), log_uniform(rng, -2, 2), log_uniform(rng, -2, 2)));
+}
+
 // Uniform barycentrics over the triangle (the square-root warp).
 std::array<double, 3> random_barycentrics(std::mt19937_64& rng) {
     std::uniform_real_distribution<double> uniform;
@@ -453,11 +461,7 @@ TEST_CASE_TEMPLATE("a fixed 1e-4 offset along the normal re-hits in float and ov
 TEST_CASE_TEMPLATE("InstanceTransforms: the residual bounds |A M - I|", Real, float, double) {
     std::mt19937_64 rng(23);
     for (int i = 0; i < 2000; ++i) {
-        const glm::dmat4 transform =
-            prism::translation(glm::dvec3(random_sign(rng) * log_uniform(rng, -3, 5), random_sign(rng) * log_uniform(rng, -3, 5),
-                                          random_sign(rng) * log_uniform(rng, -3, 5))) *
-            prism::rotation(360 * std::uniform_real_distribution<double>()(rng), random_unit_vector(rng)) *
-            prism::scaling(glm::dvec3(log_uniform(rng, -2, 2), log_uniform(rng, -2, 2), log_uniform(rng, -2, 2)));
+        const glm::dmat4 transform = random_instance_transform(rng);
         const prism::InstanceTransforms<Real> instance(transform);
         for (int column = 0; column < 4; ++column)
             for (int row = 0; row < 3; ++row) {
@@ -480,11 +484,7 @@ TEST_CASE_TEMPLATE("InstanceTransforms: round_trip bounds a point's way to world
     long trips = 0;
     Wide largest_share = 0;  // of the bound that a round trip used
     for (int i = 0; i < 2000; ++i) {
-        const glm::dmat4 transform =
-            prism::translation(glm::dvec3(random_sign(rng) * log_uniform(rng, -3, 5), random_sign(rng) * log_uniform(rng, -3, 5),
-                                          random_sign(rng) * log_uniform(rng, -3, 5))) *
-            prism::rotation(360 * std::uniform_real_distribution<double>()(rng), random_unit_vector(rng)) *
-            prism::scaling(glm::dvec3(log_uniform(rng, -2, 2), log_uniform(rng, -2, 2), log_uniform(rng, -2, 2)));
+        const glm::dmat4 transform = random_instance_transform(rng);
         const prism::InstanceTransforms<Real> instance(transform);
         const prism::Mat4<Real>& m = instance.object_to_world;
         const prism::Mat4<Real>& a = instance.world_to_object;
@@ -563,11 +563,7 @@ InstancedCounts reintersect_instanced(int triangle_count, int rays_per_triangle,
             mesh.positions.push_back(
                 rounded_to<Real>(offset + size * glm::dvec3(symmetric(rng), symmetric(rng), symmetric(rng))));
         mesh.triangles.push_back({0, 1, 2});
-        mesh.transform =
-            prism::translation(glm::dvec3(random_sign(rng) * log_uniform(rng, -3, 5), random_sign(rng) * log_uniform(rng, -3, 5),
-                                          random_sign(rng) * log_uniform(rng, -3, 5))) *
-            prism::rotation(360 * std::uniform_real_distribution<double>()(rng), random_unit_vector(rng)) *
-            prism::scaling(glm::dvec3(log_uniform(rng, -2, 2), log_uniform(rng, -2, 2), log_uniform(rng, -2, 2)));
+        mesh.transform = random_instance_transform(rng);
         prism::scene::Scene scene;
         scene.meshes.push_back(mesh);
         const prism::SceneGeometry<Real, prism::Bvh<I>> geometry(scene);

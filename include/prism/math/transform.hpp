@@ -59,10 +59,7 @@ template <Scalar Real>
 // ray direction scaled with the object keeps its parameter t meaning the same distance.
 template <Scalar Real>
 [[gnu::always_inline]] inline Vec3<Real> transform_direction(const Mat4<Real>& matrix, const Vec3<Real>& direction) {
-    Vec3<Real> result;
-    for (int row = 0; row < 3; ++row)
-        result[row] = matrix[0][row] * direction.x + matrix[1][row] * direction.y + matrix[2][row] * direction.z;
-    return result;
+    return transform_direction(Mat3<Real>(matrix), direction);
 }
 
 // The inverse transpose of the upper 3x3: it keeps normals perpendicular to transformed tangents
