@@ -593,9 +593,13 @@ private:
         return !instance.transformed;
     }
 
+    // Forced inline, as occludes below: the top level's leaf callbacks call them for every
+    // object they reach, and with to_object forced inline GCC put both out of line (nm).
     template <BackfaceCulling Culling>
-    bool intersect_instance(const Instance& instance, const Ray<Real>& ray, const TraversalRay& traversal_ray,
-                            std::optional<TriangleRay>& world_triangle_ray, Real& t_max, Hit<Real>& hit) const {
+    [[gnu::always_inline]] bool intersect_instance(const Instance& instance, const Ray<Real>& ray,
+                                                   const TraversalRay& traversal_ray,
+                                                   std::optional<TriangleRay>& world_triangle_ray, Real& t_max,
+                                                   Hit<Real>& hit) const {
         if (instance.kind == Kind::mesh) {
             const auto& mesh = meshes_[instance.shape];
             const bool cull = culls_back_faces(Culling, mesh.smooth());
@@ -616,7 +620,7 @@ private:
         return true;
     }
 
-    bool occludes(const Instance& instance, const Ray<Real>& ray, const TraversalRay& traversal_ray,
+    [[gnu::always_inline]] bool occludes(const Instance& instance, const Ray<Real>& ray, const TraversalRay& traversal_ray,
                   std::optional<TriangleRay>& world_triangle_ray, Real t_max) const {
         if (instance.kind == Kind::mesh && in_world_space(instance)) {
             if (!world_triangle_ray) world_triangle_ray.emplace(ray);
