@@ -57,6 +57,14 @@ glm::dvec3 random_unit_vector(std::mt19937_64& rng) {
     }
 }
 
+// An instance's transform: translation up to 1e5, a rotation, scales 0.01..100 per axis.
+glm::dmat4 random_instance_transform(std::mt19937_64& rng) {
+    return prism::translation(glm::dvec3(random_sign(rng) * log_uniform(rng, -3, 5), random_sign(rng) * log_uniform(rng, -3, 5),
+                                         random_sign(rng) * log_uniform(rng, -3, 5))) *
+           prism::rotation(360 * std::uniform_real_distribution<double>()(rng), random_unit_vector(rng)) *
+           prism::scaling(glm::dvec3(log_uniform(rng, -2, 2), log_uniform(rng, -2, 2), log_uniform(rng, -2, 2)));
+}
+
 // Uniform barycentrics over the triangle (the square-root warp).
 std::array<double, 3> random_barycentrics(std::mt19937_64& rng) {
     std::uniform_real_distribution<double> uniform;
@@ -307,6 +315,50 @@ TEST_CASE_TEMPLATE("offset_ray_origin: to the side of the direction, past the er
     }
 }
 
+// triangle_spawn_point widens triangle_hit_point's box by the intersector's margin
+// 16 u R (R^2 / 2A) along the unit normal (R the farthest vertex from the hit point, 2A |cross|),
+// each axis rounded up to Real: checked against that quantity summed in long double, on random
+// triangles from slivers to fat ones, at scales 1e-6 to 1e6.
+TEST_CASE_TEMPLATE("triangle_spawn_point: the margin along the normal is 16 u R^3 / 2A", Real, float, double) {
+    using Vec3 = prism::Vec3<Real>;
+    std::mt19937_64 rng(37);
+    std::uniform_real_distribution<double> symmetric(-1.0, 1.0);
+    int checked = 0;
+    for (int i = 0; i < 20000; ++i) {
+        const double size = log_uniform(rng, -6, 6);
+        const glm::dvec3 stretch(log_uniform(rng, -3, 0), 1, 1);  // slivers too
+        std::array<Vec3, 3> p;
+        for (auto& vertex : p) vertex = Vec3(size * stretch * glm::dvec3(symmetric(rng), symmetric(rng), symmetric(rng)));
+        const auto b = random_barycentrics(rng);
+        const Real b1 = Real(b[1]), b2 = Real(b[2]);
+        const prism::PointWithError<Real> hit = prism::triangle_hit_point(p[0], p[1], p[2], b1, b2);
+        const prism::PointWithError<Real> spawn = prism::triangle_spawn_point(p[0], p[1], p[2], b1, b2);
+        REQUIRE(spawn.point == hit.point);
+        const WideVec3 w0 = widen(p[0]), w1 = widen(p[1]), w2 = widen(p[2]), at = widen(hit.point);
+        // The cross product as the function takes it, in double: its components can cancel
+        // (slivers), and the margin is only an estimate whose factor 16 leaves room for that.
+        const glm::dvec3 q0(p[0]), q1(p[1]), q2(p[2]);
+        const glm::dvec3 narrow_cross = glm::cross(q1 - q0, q2 - q0);
+        const WideVec3 cross(Wide(narrow_cross.x), Wide(narrow_cross.y), Wide(narrow_cross.z));
+        const Wide twice_area = std::sqrt(glm::dot(cross, cross));
+        if (!(twice_area > 0)) continue;
+        Wide reach_squared = 0;
+        for (const WideVec3& w : {w0, w1, w2}) reach_squared = std::max(reach_squared, glm::dot(w - at, w - at));
+        const Wide margin = 16 * Wide(prism::unit_roundoff<Real>) * std::sqrt(reach_squared) * reach_squared / twice_area;
+        for (int axis = 0; axis < 3; ++axis) {
+            const Wide along = margin * std::abs(cross[axis]) / twice_area;
+            const Wide added = Wide(spawn.error[axis]) - Wide(hit.error[axis]);
+            // Summed in double (a dozen roundings), rounded up to Real, then added to the error
+            // in Real: within a few ulps of the error of the margin summed exactly.
+            const Wide slack = 16 * Wide(std::numeric_limits<Real>::epsilon()) * Wide(spawn.error[axis]);
+            REQUIRE(added >= along - slack);
+            REQUIRE(added <= along * (1 + 1e-3L) + slack);
+        }
+        ++checked;
+    }
+    CHECK(checked > 19000);
+}
+
 // pbrt-v4's double build computed float-sized bounds for years; each helper's double bound must
 // be double-sized: for a point of magnitude 1, below 1e-14 (a float-sized one is above 1e-7).
 TEST_CASE("double bounds are double-sized, float bounds float-sized") {
@@ -409,11 +461,7 @@ TEST_CASE_TEMPLATE("a fixed 1e-4 offset along the normal re-hits in float and ov
 TEST_CASE_TEMPLATE("InstanceTransforms: the residual bounds |A M - I|", Real, float, double) {
     std::mt19937_64 rng(23);
     for (int i = 0; i < 2000; ++i) {
-        const glm::dmat4 transform =
-            prism::translation(glm::dvec3(random_sign(rng) * log_uniform(rng, -3, 5), random_sign(rng) * log_uniform(rng, -3, 5),
-                                          random_sign(rng) * log_uniform(rng, -3, 5))) *
-            prism::rotation(360 * std::uniform_real_distribution<double>()(rng), random_unit_vector(rng)) *
-            prism::scaling(glm::dvec3(log_uniform(rng, -2, 2), log_uniform(rng, -2, 2), log_uniform(rng, -2, 2)));
+        const glm::dmat4 transform = random_instance_transform(rng);
         const prism::InstanceTransforms<Real> instance(transform);
         for (int column = 0; column < 4; ++column)
             for (int row = 0; row < 3; ++row) {
@@ -423,6 +471,59 @@ TEST_CASE_TEMPLATE("InstanceTransforms: the residual bounds |A M - I|", Real, fl
                 REQUIRE(std::abs(product - (column == row ? 1 : 0)) <= Wide(instance.residual[column][row]));
             }
     }
+}
+
+// round_trip: K |o| + k, precomputed, against the bound it stands for (the sum of the residual,
+// the way out's error carried through |A| and the way back's rounding, summed term by term in
+// long double from the stored entries), and against real round trips of points through the
+// rounded matrices: out in pbrt's order, back in GLM's order and in the reverse one.
+TEST_CASE_TEMPLATE("InstanceTransforms: round_trip bounds a point's way to world space and back", Real, float, double) {
+    using Vec3 = prism::Vec3<Real>;
+    std::mt19937_64 rng(29);
+    const Wide g3 = Wide(prism::gamma<Real>(3)), g4 = Wide(prism::gamma<Real>(4));
+    long trips = 0;
+    Wide largest_share = 0;  // of the bound that a round trip used
+    for (int i = 0; i < 2000; ++i) {
+        const glm::dmat4 transform = random_instance_transform(rng);
+        const prism::InstanceTransforms<Real> instance(transform);
+        const prism::Mat4<Real>& m = instance.object_to_world;
+        const prism::Mat4<Real>& a = instance.world_to_object;
+        for (int j = 0; j < 50; ++j) {
+            Vec3 o;
+            for (int axis = 0; axis < 3; ++axis) o[axis] = Real(random_sign(rng) * log_uniform(rng, -4, 4));
+            const Vec3 magnitude = glm::abs(o);
+            const Vec3 bound = instance.round_trip(magnitude);
+            for (int row = 0; row < 3; ++row) {
+                Wide stands_for = Wide(instance.residual[3][row]);
+                for (int k = 0; k < 3; ++k) stands_for += Wide(instance.residual[k][row]) * Wide(magnitude[k]);
+                for (int k = 0; k < 3; ++k) {
+                    Wide through = std::abs(Wide(m[3][k]));  // (|M| |o| + |t_M|)[k]
+                    for (int l = 0; l < 3; ++l) through += std::abs(Wide(m[l][k])) * Wide(magnitude[l]);
+                    stands_for += std::abs(Wide(a[k][row])) * (g3 + g4 * (1 + g3)) * through;
+                }
+                stands_for += g4 * std::abs(Wide(a[3][row]));
+                REQUIRE(Wide(bound[row]) >= stands_for);
+                // Not loose either: the widening for the bound's own roundings is a few ulps and
+                // the 2^-30 that covers the double sums.
+                REQUIRE(Wide(bound[row]) <= stands_for * (1 + 64 * Wide(prism::unit_roundoff<Real>)) * (1 + 0x1p-29L));
+            }
+            const Vec3 w = prism::transform_point(m, o);
+            const Vec3 back_glm = Vec3(a * prism::Vec4<Real>(w, Real(1)));
+            Vec3 back_reversed;
+            for (int row = 0; row < 3; ++row)
+                back_reversed[row] = ((a[3][row] + a[2][row] * w.z) + a[1][row] * w.y) + a[0][row] * w.x;
+            for (const Vec3& back : {back_glm, back_reversed}) {
+                ++trips;
+                for (int axis = 0; axis < 3; ++axis) {
+                    const Wide moved = std::abs(Wide(back[axis]) - Wide(o[axis]));
+                    REQUIRE(moved <= Wide(bound[axis]));
+                    largest_share = std::max(largest_share, moved / Wide(bound[axis]));
+                }
+            }
+        }
+    }
+    MESSAGE(trips, " round trips; the largest took ", double(largest_share), " of its bound");
+    CHECK(largest_share > 0);
 }
 
 namespace {
@@ -462,11 +563,7 @@ InstancedCounts reintersect_instanced(int triangle_count, int rays_per_triangle,
             mesh.positions.push_back(
                 rounded_to<Real>(offset + size * glm::dvec3(symmetric(rng), symmetric(rng), symmetric(rng))));
         mesh.triangles.push_back({0, 1, 2});
-        mesh.transform =
-            prism::translation(glm::dvec3(random_sign(rng) * log_uniform(rng, -3, 5), random_sign(rng) * log_uniform(rng, -3, 5),
-                                          random_sign(rng) * log_uniform(rng, -3, 5))) *
-            prism::rotation(360 * std::uniform_real_distribution<double>()(rng), random_unit_vector(rng)) *
-            prism::scaling(glm::dvec3(log_uniform(rng, -2, 2), log_uniform(rng, -2, 2), log_uniform(rng, -2, 2)));
+        mesh.transform = random_instance_transform(rng);
         prism::scene::Scene scene;
         scene.meshes.push_back(mesh);
         const prism::SceneGeometry<Real, prism::Bvh<I>> geometry(scene);

@@ -17,6 +17,7 @@
 #include <prism/geometry/sphere.hpp>
 #include <prism/geometry/surface_error.hpp>
 #include <prism/geometry/triangle_mesh.hpp>
+#include <prism/math/transform.hpp>
 #include <prism/scene/scene.hpp>
 #include <prism/simd/pack.hpp>
 
@@ -24,6 +25,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <optional>
 #include <span>
@@ -383,11 +385,18 @@ public:
             point.texture_position = point.position;
         }
         if (instance.transformed) {
-            geometric_normal = glm::normalize(instance.normal_to_world * geometric_normal);
-            shading_normal = glm::normalize(instance.normal_to_world * shading_normal);
-            // Tangents are directions on the surface: they map by the linear part itself.
-            point.dpdu = instance.object_to_world_linear * point.dpdu;
-            point.dpdv = instance.object_to_world_linear * point.dpdv;
+            // Spheres and flat meshes shade with the geometric normal itself (the same bits):
+            // it is mapped and normalised once.
+            const bool one_normal = std::memcmp(&geometric_normal, &shading_normal, sizeof(geometric_normal)) == 0;
+            geometric_normal = glm::normalize(transform_normal(instance.normal_to_world, geometric_normal));
+            shading_normal = one_normal ? geometric_normal
+                                        : glm::normalize(transform_normal(instance.normal_to_world, shading_normal));
+            // Tangents are directions on the surface: they map by the linear part itself. An
+            // unparametrised sphere has none (zero, and read by nothing).
+            if (Parametrised || instance.kind == Kind::mesh) {
+                point.dpdu = transform_direction(instance.object_to_world_linear, point.dpdu);
+                point.dpdv = transform_direction(instance.object_to_world_linear, point.dpdv);
+            }
         }
         point.geometric_normal = geometric_normal;
         point.shading_normal = shading_normal;
@@ -427,7 +436,7 @@ public:
         if (point.object >= instances_.size()) return glm::dot(direction, point.object_normal) < 0;
         const Instance& instance = instances_[point.object];
         int side = instance.transformed
-                       ? glm::dot(Mat3<Real>(transforms_[instance.transform].world_to_object) * direction,
+                       ? glm::dot(transform_direction(transforms_[instance.transform].world_to_object, direction),
                                   point.object_normal) < 0
                        : glm::dot(direction, point.object_normal) < 0;
         if constexpr (MotionBlur) {
@@ -458,10 +467,13 @@ private:
         Vec3<Real> motion{0};
         Aabb<Real> world_bounds;
 
-        Vec3<Real> to_object(const Vec3<Real>& p) const { return Vec3<Real>(world_to_object * Vec4<Real>(p, 1)); }
+        // Forced inline: the direct spheres' test calls it for every ray a transformed sphere may
+        // meet, and GCC left it out of line there (8% of hw2 spheres.json).
+        [[gnu::always_inline]] Vec3<Real> to_object(const Vec3<Real>& p) const { return transform_point(world_to_object, p); }
         // The direction is transformed but not renormalised, so t means the same in both spaces.
-        Ray<Real> to_object(const Ray<Real>& ray) const {
-            return {to_object(ray.origin), world_to_object_linear * ray.direction, ray.t_min, ray.t_max, ray.time};
+        [[gnu::always_inline]] Ray<Real> to_object(const Ray<Real>& ray) const {
+            return {to_object(ray.origin), transform_direction(world_to_object_linear, ray.direction), ray.t_min, ray.t_max,
+                    ray.time};
         }
     };
 
@@ -544,7 +556,8 @@ private:
     }
 
     // The ray in the instance's object space, at the ray's instant for moving instances.
-    Ray<Real> to_object(const Instance& instance, const Ray<Real>& ray) const {
+    // Forced inline as Instance::to_object is (the top level's leaf and the direct meshes call it).
+    [[gnu::always_inline]] Ray<Real> to_object(const Instance& instance, const Ray<Real>& ray) const {
         if constexpr (MotionBlur) {
             if (instance.moving) {
                 Ray<Real> unmoved = ray;
@@ -580,9 +593,13 @@ private:
         return !instance.transformed;
     }
 
+    // Forced inline, as occludes below: the top level's leaf callbacks call them for every
+    // object they reach, and with to_object forced inline GCC put both out of line (nm).
     template <BackfaceCulling Culling>
-    bool intersect_instance(const Instance& instance, const Ray<Real>& ray, const TraversalRay& traversal_ray,
-                            std::optional<TriangleRay>& world_triangle_ray, Real& t_max, Hit<Real>& hit) const {
+    [[gnu::always_inline]] bool intersect_instance(const Instance& instance, const Ray<Real>& ray,
+                                                   const TraversalRay& traversal_ray,
+                                                   std::optional<TriangleRay>& world_triangle_ray, Real& t_max,
+                                                   Hit<Real>& hit) const {
         if (instance.kind == Kind::mesh) {
             const auto& mesh = meshes_[instance.shape];
             const bool cull = culls_back_faces(Culling, mesh.smooth());
@@ -603,7 +620,7 @@ private:
         return true;
     }
 
-    bool occludes(const Instance& instance, const Ray<Real>& ray, const TraversalRay& traversal_ray,
+    [[gnu::always_inline]] bool occludes(const Instance& instance, const Ray<Real>& ray, const TraversalRay& traversal_ray,
                   std::optional<TriangleRay>& world_triangle_ray, Real t_max) const {
         if (instance.kind == Kind::mesh && in_world_space(instance)) {
             if (!world_triangle_ray) world_triangle_ray.emplace(ray);

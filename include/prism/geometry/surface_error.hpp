@@ -9,6 +9,7 @@
 #pragma once
 
 #include <prism/math/floating_point.hpp>
+#include <prism/math/transform.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -77,13 +78,16 @@ PointWithError<Real> triangle_spawn_point(const Vec3<Vertex>& p0, const Vec3<Ver
     const double reach_squared = std::max({glm::dot(q0 - hit, q0 - hit), glm::dot(q1 - hit, q1 - hit),
                                            glm::dot(q2 - hit, q2 - hit)});
     const glm::dvec3 cross = glm::cross(q1 - q0, q2 - q0);
-    const double twice_area = glm::length(cross);
+    // (2A)^2: zero where glm::length(cross) would be, including underflow.
+    const double twice_area_squared = glm::dot(cross, cross);
     // A triangle of no area has no plane to leave, and the watertight test never hits it.
-    if (!(twice_area > 0)) return result;
-    const double margin = double(gamma<Vertex>(16)) * std::sqrt(reach_squared) * (reach_squared / twice_area);
+    if (!(twice_area_squared > 0)) return result;
+    // margin = c u R (R^2 / 2A), added along the unit normal n = cross / 2A: margin |n_i| is
+    // c u R R^2 |cross_i| / (2A)^2, one square root and one division (a fifth of the function's
+    // time went to the length's square root and four divisions).
+    const double scale = double(gamma<Vertex>(16)) * std::sqrt(reach_squared) * (reach_squared / twice_area_squared);
     // Adding margin |n| to the box adds exactly margin to offset_ray_origin's |n| . error.
-    const glm::dvec3 normal = glm::abs(cross / twice_area);
-    for (int axis = 0; axis < 3; ++axis) result.error[axis] += next_up(Real(margin * normal[axis]));
+    for (int axis = 0; axis < 3; ++axis) result.error[axis] += next_up(Real(scale * std::abs(cross[axis])));
     return result;
 }
 
@@ -165,6 +169,10 @@ struct InstanceTransforms {
     Mat4<Real> object_to_world{1};  // M, rounded from the scene's transform
     Mat4<Real> world_to_object{1};  // A, rounded from its inverse: what the traversal applies
     Mat4<Real> residual{0};         // a bound on |A M - I|, entry by entry
+    // The round trip's bound as one affine map of |o| (round_trip below), computed once here
+    // rather than for every ray that leaves the instance.
+    Mat3<Real> round_trip_linear{0};
+    Vec3<Real> round_trip_constant{0};
 
     // Rounds the matrices exactly as SceneGeometry does, so A is the traversal's own matrix.
     explicit InstanceTransforms(const glm::dmat4& transform)
@@ -187,6 +195,47 @@ struct InstanceTransforms {
                                      gamma<double>(5) * (magnitude + 1.0) + stored_rounding * magnitude;
                 residual[column][row] = next_up(Real(bound));
             }
+        // The round trip o -> w = M o (pbrt's order) -> the traversal's A w, for an object-space
+        // point with |o| <= m per axis, moves it by at most, per row r,
+        //   (A M - I) o                            <= R m + R_t          (the residual)
+        //   A times the error of w, |w - M o|      <= |A| g3 (|M| m + |t_M|)
+        //   A w's own rounding, any order          <= g4 (|A| |w| + |t_A|),
+        //     with |w| <= (1 + g3) (|M| m + |t_M|)
+        // (R, |A|, |M| the 3x3 parts, R_t and t the translation columns, gk = gamma<Real>(k)):
+        // together K m + k with K = R + c |A| |M|, k = R_t + c |A| |t_M| + g4 |t_A|,
+        // c = g3 + g4 (1 + g3). Every term is non-negative. K and k are summed here in double
+        // from the stored Real entries (exact in double), a dozen roundings of 2^-53 each, which
+        // the factor 1 + 2^-30 covers; rounding to Real and one step up keeps them above that.
+        // The caller evaluates K m + k in Real: each of its four terms meets at most four
+        // roundings, so the computed value is at least (1 - g4) times the exact one, and the
+        // factor 1 + g8 (> 1 / (1 - g4)) is folded in here, so the computed value still bounds
+        // the round trip.
+        const double g3 = double(gamma<Real>(3)), g4 = double(gamma<Real>(4));
+        const double c = g3 + g4 * (1 + g3);
+        const double widen = (1 + double(gamma<Real>(8))) * (1 + 0x1p-30);
+        const auto wide_abs = [](Real v) { return std::abs(double(v)); };
+        for (int row = 0; row < 3; ++row) {
+            for (int column = 0; column < 3; ++column) {
+                double through = 0;  // (|A| |M|)[row][column]
+                for (int k = 0; k < 3; ++k)
+                    through += wide_abs(world_to_object[k][row]) * wide_abs(object_to_world[column][k]);
+                round_trip_linear[column][row] =
+                    next_up(Real((double(residual[column][row]) + c * through) * widen));
+            }
+            double carried = 0;  // (|A| |t_M|)[row]
+            for (int k = 0; k < 3; ++k) carried += wide_abs(world_to_object[k][row]) * wide_abs(object_to_world[3][k]);
+            round_trip_constant[row] = next_up(
+                Real((double(residual[3][row]) + c * carried + g4 * wide_abs(world_to_object[3][row])) * widen));
+        }
+    }
+
+    // A bound on |A (M o) - o| per axis, as computed in Real, for every o with |o| <= magnitude.
+    Vec3<Real> round_trip(const Vec3<Real>& magnitude) const {
+        Vec3<Real> bound;
+        for (int row = 0; row < 3; ++row)
+            bound[row] = round_trip_linear[0][row] * magnitude.x + round_trip_linear[1][row] * magnitude.y +
+                         round_trip_linear[2][row] * magnitude.z + round_trip_constant[row];
+        return bound;
     }
 };
 
@@ -196,11 +245,7 @@ struct InstanceTransforms {
 template <Scalar Real>
 Vec3<Real> offset_ray_origin(const InstanceTransforms<Real>& instance, const PointWithError<Real>& object_point,
                              const Vec3<Real>& object_normal, const Vec3<Real>& world_direction) {
-    const Mat4<Real>& a = instance.world_to_object;
-    const Mat4<Real>& m = instance.object_to_world;
-    const Vec3<Real> object_direction = Mat3<Real>(a) * world_direction;
-    // Room for the bound's own roundings (sums of a dozen non-negative terms).
-    const Real slack = Real(1) + gamma<Real>(16);
+    const Vec3<Real> object_direction = transform_direction(instance.world_to_object, world_direction);
     // `magnitude` bounds |o|, the object-space origin, which the round-trip bound grows with.
     // It starts at the hit point's box; if the offset carries the origin past it, it is widened
     // by twice that offset and the bound recomputed. The offset grows with |o| only by a factor
@@ -209,35 +254,14 @@ Vec3<Real> offset_ray_origin(const InstanceTransforms<Real>& instance, const Poi
     Vec3<Real> magnitude = start;
     Vec3<Real> object_origin = object_point.point;
     for (int pass = 0; pass < 4; ++pass) {
-        // Out: w = M o in pbrt's order, off by at most f = gamma(3) (|M| |o| + |t_M|).
-        // Back: the traversal's A w, in any summation order, off by gamma(4) (|A| |w| + |t_A|).
-        // In between, A M o - o = (A M - I) o, bounded with the residual.
-        Vec3<Real> forward, world_magnitude, round_trip;
-        for (int row = 0; row < 3; ++row) {
-            forward[row] = gamma<Real>(3) * slack *
-                           (std::abs(m[0][row]) * magnitude.x + std::abs(m[1][row]) * magnitude.y +
-                            std::abs(m[2][row]) * magnitude.z + std::abs(m[3][row]));
-            world_magnitude[row] = (std::abs(m[0][row]) * magnitude.x + std::abs(m[1][row]) * magnitude.y +
-                                    std::abs(m[2][row]) * magnitude.z + std::abs(m[3][row])) * slack +
-                                   forward[row];
-        }
-        for (int row = 0; row < 3; ++row) {
-            const Real residual = instance.residual[0][row] * magnitude.x + instance.residual[1][row] * magnitude.y +
-                                  instance.residual[2][row] * magnitude.z + instance.residual[3][row];
-            const Real carried = std::abs(a[0][row]) * forward.x + std::abs(a[1][row]) * forward.y +
-                                 std::abs(a[2][row]) * forward.z;
-            const Real back = gamma<Real>(4) * (std::abs(a[0][row]) * world_magnitude.x +
-                                                std::abs(a[1][row]) * world_magnitude.y +
-                                                std::abs(a[2][row]) * world_magnitude.z + std::abs(a[3][row]));
-            round_trip[row] = (residual + carried + back) * slack;
-        }
-        object_origin = offset_ray_origin(object_point.point, object_point.error + round_trip, object_normal,
-                                          object_direction);
+        object_origin = offset_ray_origin(object_point.point, object_point.error + instance.round_trip(magnitude),
+                                          object_normal, object_direction);
         const Vec3<Real> reached = glm::abs(object_origin);
         if (reached.x <= magnitude.x && reached.y <= magnitude.y && reached.z <= magnitude.z) break;
         magnitude = start + Real(2) * glm::abs(object_origin - object_point.point);
     }
-    return transform_point(m, PointWithError<Real>{object_origin, Vec3<Real>(0)}).point;
+    // Out to world space in pbrt's order, which the round-trip bound's first step assumes.
+    return transform_point(instance.object_to_world, object_origin);
 }
 
 }  // namespace prism

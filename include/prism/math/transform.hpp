@@ -33,16 +33,33 @@ inline glm::dmat4 composite_from_row_major(const std::array<double, 16>& rows) {
 }
 
 // The transforms are affine, so the homogeneous coordinate stays 1 and needs no division.
+// Each coordinate is summed as (m0 x + m1 y) + (m2 z + t): GLM's order for matrix * vec4(p, 1)
+// (its m3 * 1 is exact), so the bits are GLM's, and pbrt's order, whose gamma(3) rounding bound
+// geometry/surface_error.hpp relies on. Written out rather than through GLM so that it inlines:
+// GCC left GLM's product out of line on the spawn and hit-point paths of instanced scenes.
 template <Scalar Real>
-Vec3<Real> transform_point(const Mat4<Real>& matrix, const Vec3<Real>& point) {
-    return Vec3<Real>(matrix * Vec4<Real>(point, Real(1)));
+[[gnu::always_inline]] inline Vec3<Real> transform_point(const Mat4<Real>& matrix, const Vec3<Real>& point) {
+    Vec3<Real> result;
+    for (int row = 0; row < 3; ++row)
+        result[row] = (matrix[0][row] * point.x + matrix[1][row] * point.y) + (matrix[2][row] * point.z + matrix[3][row]);
+    return result;
+}
+
+// A 3x3 matrix applied to a vector, summed as (m0 x + m1 y) + m2 z: GLM's order and bits,
+// written out to inline for the same reason as transform_point.
+template <Scalar Real>
+[[gnu::always_inline]] inline Vec3<Real> transform_direction(const Mat3<Real>& matrix, const Vec3<Real>& direction) {
+    Vec3<Real> result;
+    for (int row = 0; row < 3; ++row)
+        result[row] = matrix[0][row] * direction.x + matrix[1][row] * direction.y + matrix[2][row] * direction.z;
+    return result;
 }
 
 // Directions (gaze, up, ray directions, tangents) ignore the translation. Not renormalised: a
 // ray direction scaled with the object keeps its parameter t meaning the same distance.
 template <Scalar Real>
-Vec3<Real> transform_direction(const Mat4<Real>& matrix, const Vec3<Real>& direction) {
-    return Mat3<Real>(matrix) * direction;
+[[gnu::always_inline]] inline Vec3<Real> transform_direction(const Mat4<Real>& matrix, const Vec3<Real>& direction) {
+    return transform_direction(Mat3<Real>(matrix), direction);
 }
 
 // The inverse transpose of the upper 3x3: it keeps normals perpendicular to transformed tangents
@@ -54,8 +71,8 @@ Mat3<Real> normal_matrix(const Mat4<Real>& matrix) {
 
 // Not renormalised, as the caller usually normalises after interpolation anyway.
 template <Scalar Real>
-Vec3<Real> transform_normal(const Mat3<Real>& inverse_transpose, const Vec3<Real>& normal) {
-    return inverse_transpose * normal;
+[[gnu::always_inline]] inline Vec3<Real> transform_normal(const Mat3<Real>& inverse_transpose, const Vec3<Real>& normal) {
+    return transform_direction(inverse_transpose, normal);
 }
 
 // For one normal: inverts the matrix on every call.
