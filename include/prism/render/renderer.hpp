@@ -18,6 +18,8 @@
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <span>
 #include <stdexcept>
@@ -77,9 +79,14 @@ public:
                           [&](const tbb::blocked_range2d<int>& tile) {
                               std::vector<CameraSample<Real>> samples;
                               std::vector<Vec2<Real>> scratch;
-                              for (int y = tile.rows().begin(); y < tile.rows().end(); ++y)
+                              for (int y = tile.rows().begin(); y < tile.rows().end(); ++y) {
+                                  if (count == 1) {
+                                      one_sample_row(lens, camera, y, tile.cols().begin(), tile.cols().end(), image);
+                                      continue;
+                                  }
                                   for (int x = tile.cols().begin(); x < tile.cols().end(); ++x)
                                       image(x, y) = pixel(lens, camera, count, x, y, samples, scratch);
+                              }
                               on_tile(int(tile.rows().size() * tile.cols().size()));
                           });
         return image;
@@ -94,16 +101,60 @@ public:
     }
 
 private:
-    glm::vec3 pixel(const ThinLensCamera<Real>& lens, const scene::Camera& camera, int count, int x, int y,
-                    std::vector<CameraSample<Real>>& samples, std::vector<Vec2<Real>>& scratch) const {
-        const scene::PixelFilter filter = camera.filter;
-        Random random = Random::for_pixel(x, y, settings_.seed);
+    // The path a camera ray of pixel (x, y) carries, drawing from `random`.
+    typename Integrator::CameraPath camera_path(const ThinLensCamera<Real>& lens, const scene::Camera& camera,
+                                                Random& random, int x, int y) const {
         typename Integrator::CameraPath path{
             random, Vec2<Real>((Real(x) + Real(0.5)) / Real(lens.width()), (Real(y) + Real(0.5)) / Real(lens.height())),
             lens.pixel_spread()};
         // Integrators that render cameras differently (the path tracer's RendererParams) learn
         // the camera's choice here.
         if constexpr (requires { path.renderer; }) path.renderer = camera.renderer;
+        return path;
+    }
+
+    // The pixels [begin, end) of row y with one sample each (every hw1-hw2 camera), as pixel()
+    // renders them, bit for bit: first every pixel's stream and camera ray, then every trace.
+    // A pixel's stream (two rounds of mix_bits, three draws) and its ray (a square root and a
+    // division) depend on no other pixel's, so the core overlaps them from pixel to pixel,
+    // where one pixel at a time waited for them before its trace (the per-pixel lambda was
+    // 14% of hw1 simple_reflectance's samples, a quarter of it on the ray's division).
+    void one_sample_row(const ThinLensCamera<Real>& lens, const scene::Camera& camera, int y, int begin, int end,
+                        Image& image) const {
+        constexpr int batch = tile_size;
+        std::array<Random, batch> streams;
+        std::array<Ray<Real>, batch> rays;
+        for (int start = begin; start < end; start += batch) {
+            const int n = std::min(batch, end - start);
+            for (int i = 0; i < n; ++i) {
+                const int x = start + i;
+                streams[std::size_t(i)] = Random::for_pixel(x, y, settings_.seed);
+                const CameraSample<Real> sample = centre_sample<Real>(streams[std::size_t(i)]);
+                rays[std::size_t(i)] =
+                    stored_whole(lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time));
+            }
+            for (int i = 0; i < n; ++i) {
+                const int x = start + i;
+                typename Integrator::CameraPath path = camera_path(lens, camera, streams[std::size_t(i)], x, y);
+                image(x, y) = one_sample_pixel(integrator_.radiance(rays[std::size_t(i)], path));
+            }
+        }
+    }
+
+    // A one-sample pixel's value, the sum and division of pixel() with the weight 1.
+    static glm::vec3 one_sample_pixel(const Vec3<Real>& radiance) {
+        Vec3<Real> sum(0);
+        Real weights = 0;
+        sum += Real(1) * radiance;
+        weights += Real(1);
+        return glm::vec3(sum / weights);
+    }
+
+    glm::vec3 pixel(const ThinLensCamera<Real>& lens, const scene::Camera& camera, int count, int x, int y,
+                    std::vector<CameraSample<Real>>& samples, std::vector<Vec2<Real>>& scratch) const {
+        const scene::PixelFilter filter = camera.filter;
+        Random random = Random::for_pixel(x, y, settings_.seed);
+        typename Integrator::CameraPath path = camera_path(lens, camera, random, x, y);
         // One sample (every hw1-hw2 camera) is drawn here without the sample vector; both filters
         // weigh the pixel centre exactly 1 (exp(-0)), so its weight is not computed: the same sum
         // and division as for any count, the same bits.
