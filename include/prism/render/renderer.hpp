@@ -21,7 +21,6 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
-#include <span>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -77,15 +76,14 @@ public:
         Image image(width, height, Image::Unfilled{});  // every pixel is written below
         tbb::parallel_for(tbb::blocked_range2d<int>(0, height, tile_size, 0, width, tile_size),
                           [&](const tbb::blocked_range2d<int>& tile) {
-                              std::vector<CameraSample<Real>> samples;
-                              std::vector<Vec2<Real>> scratch;
+                              PixelScratch scratch;
                               for (int y = tile.rows().begin(); y < tile.rows().end(); ++y) {
                                   if (count == 1) {
                                       one_sample_row(lens, camera, y, tile.cols().begin(), tile.cols().end(), image);
                                       continue;
                                   }
                                   for (int x = tile.cols().begin(); x < tile.cols().end(); ++x)
-                                      image(x, y) = pixel(lens, camera, count, x, y, samples, scratch);
+                                      image(x, y) = pixel(lens, camera, count, x, y, scratch);
                               }
                               on_tile(int(tile.rows().size() * tile.cols().size()));
                           });
@@ -113,8 +111,10 @@ private:
         return path;
     }
 
-    // The pixels [begin, end) of row y with one sample each (every hw1-hw2 camera), as pixel()
-    // renders them, bit for bit: first every pixel's stream and camera ray, then every trace.
+    // The pixels [begin, end) of row y with one sample each (every hw1-hw2 camera): first every
+    // pixel's stream and camera ray, then every trace. The sample is the centre (centre_sample,
+    // as camera_samples(1, ...) draws it), which both filters weigh exactly 1 (exp(-0)), so the
+    // weight is not computed: the same sum and division as for any count, the same bits.
     // A pixel's stream (two rounds of mix_bits, three draws) and its ray (a square root and a
     // division) depend on no other pixel's, so the core overlaps them from pixel to pixel,
     // where one pixel at a time waited for them before its trace (the per-pixel lambda was
@@ -150,30 +150,37 @@ private:
         return glm::vec3(sum / weights);
     }
 
+    // What a tile's multi-sample pixels reuse, so that no pixel allocates.
+    struct PixelScratch {
+        std::vector<CameraSample<Real>> samples;
+        std::vector<Vec2<Real>> strata;
+        std::vector<Ray<Real>> rays;
+        std::vector<Real> weights;
+    };
+
+    // A pixel of several samples: every sample's ray and filter weight first, then the traces.
+    // As in one_sample_row, the rays and weights depend on no trace (and draw nothing), so
+    // their divisions, square roots and exponentials overlap, and the sums are the same.
     glm::vec3 pixel(const ThinLensCamera<Real>& lens, const scene::Camera& camera, int count, int x, int y,
-                    std::vector<CameraSample<Real>>& samples, std::vector<Vec2<Real>>& scratch) const {
+                    PixelScratch& scratch) const {
         const scene::PixelFilter filter = camera.filter;
         Random random = Random::for_pixel(x, y, settings_.seed);
         typename Integrator::CameraPath path = camera_path(lens, camera, random, x, y);
-        // One sample (every hw1-hw2 camera) is drawn here without the sample vector; both filters
-        // weigh the pixel centre exactly 1 (exp(-0)), so its weight is not computed: the same sum
-        // and division as for any count, the same bits.
-        CameraSample<Real> centre;
-        std::span<const CameraSample<Real>> drawn(&centre, 1);
-        if (count == 1) {
-            centre = centre_sample<Real>(random);
-        } else {
-            camera_samples(count, random, samples, scratch);
-            drawn = samples;
+        camera_samples(count, random, scratch.samples, scratch.strata);
+        const std::size_t n = scratch.samples.size();
+        scratch.rays.resize(n);
+        scratch.weights.resize(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            const CameraSample<Real>& sample = scratch.samples[i];
+            scratch.rays[i] =
+                stored_whole(lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time));
+            scratch.weights[i] = filter_weight(filter, sample.pixel);
         }
         Vec3<Real> sum(0);
         Real weights = 0;
-        for (const CameraSample<Real>& sample : drawn) {
-            const Ray<Real> ray =
-                stored_whole(lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time));
-            const Real weight = count == 1 ? Real(1) : filter_weight(filter, sample.pixel);
-            sum += weight * integrator_.radiance(ray, path);
-            weights += weight;
+        for (std::size_t i = 0; i < n; ++i) {
+            sum += scratch.weights[i] * integrator_.radiance(scratch.rays[i], path);
+            weights += scratch.weights[i];
         }
         return glm::vec3(sum / weights);
     }
