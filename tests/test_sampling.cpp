@@ -292,6 +292,53 @@ TEST_CASE_TEMPLATE("Renderer: a one-sample pixel is camera_samples' one sample, 
     CHECK(lit > 50);  // the light reaches the ball and the floor
 }
 
+TEST_CASE_TEMPLATE("Renderer: a multi-sample pixel is its samples' filter-weighted mean, in their order, bit for bit",
+                   Real, float, double) {
+    // Renderer::pixel computes every sample's ray and weight before tracing any (whole9): the
+    // sum must still add w_i L_i in camera_samples' order and divide by the sum of the weights.
+    // Point lights and matte surfaces draw nothing after the camera samples, so radiance()
+    // gives each sample's radiance along its ray. 4 samples (a jittered grid) and 5 (n-rooks).
+    for (const int count : {4, 5}) {
+        scene::Scene world;
+        scene::Camera camera = looking_down_z(20, 12);
+        camera.num_samples = count;
+        camera.aperture_size = 0.3;
+        camera.focus_distance = 7;
+        camera.filter = scene::PixelFilter::gaussian;
+        world.cameras.push_back(camera);
+        world.materials.push_back(matte(0.7));
+        world.planes.push_back({"floor", 0, {0, -1, 0}, {0, 1, 0}, glm::dmat4(1.0)});
+        world.spheres.push_back({"ball", 0, {0.3, 0, 0}, 1, glm::dmat4(1.0)});
+        world.point_lights.push_back({"bulb", {2, 5, 3}, {40, 40, 40}});
+        using Punctual = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::PointLightSet>;
+        const prism::Renderer<Punctual> renderer(world);
+        const prism::Image image = renderer.render(world.cameras[0]);
+        const prism::ThinLensCamera<Real> lens(camera, camera.width, camera.height);
+        std::vector<prism::CameraSample<Real>> samples;
+        std::vector<prism::Vec2<Real>> scratch;
+        int mismatches = 0, lit = 0;
+        for (int y = 0; y < camera.height; ++y)
+            for (int x = 0; x < camera.width; ++x) {
+                prism::Random random = prism::Random::for_pixel(x, y, 0);
+                prism::camera_samples(count, random, samples, scratch);
+                prism::Vec3<Real> sum(0);
+                Real weights = 0;
+                for (const prism::CameraSample<Real>& sample : samples) {
+                    const prism::Ray<Real> ray =
+                        lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time);
+                    const Real weight = prism::filter_weight(camera.filter, sample.pixel);
+                    sum += weight * renderer.radiance(ray);
+                    weights += weight;
+                }
+                const glm::vec3 expected(sum / weights);
+                mismatches += std::memcmp(&expected, &image(x, y), sizeof expected) != 0;
+                lit += expected.r > 0.0f;
+            }
+        CHECK(mismatches == 0);
+        CHECK(lit > 50);  // the light reaches the ball and the floor
+    }
+}
+
 TEST_CASE("render_scene: a fitted renderer refuses what it was compiled without") {
     scene::Scene world;
     world.cameras.push_back(looking_down_z(2, 2));

@@ -73,17 +73,18 @@ public:
         check_image(camera, width, height);
         const ThinLensCamera<Real> lens(camera, width, height);
         const int count = std::max(1, camera.num_samples);
+        const Real spread = lens.pixel_spread();
         Image image(width, height, Image::Unfilled{});  // every pixel is written below
         tbb::parallel_for(tbb::blocked_range2d<int>(0, height, tile_size, 0, width, tile_size),
                           [&](const tbb::blocked_range2d<int>& tile) {
                               PixelScratch scratch;
                               for (int y = tile.rows().begin(); y < tile.rows().end(); ++y) {
                                   if (count == 1) {
-                                      one_sample_row(lens, camera, y, tile.cols().begin(), tile.cols().end(), image);
+                                      one_sample_row(lens, camera, spread, y, tile.cols().begin(), tile.cols().end(), image);
                                       continue;
                                   }
                                   for (int x = tile.cols().begin(); x < tile.cols().end(); ++x)
-                                      image(x, y) = pixel(lens, camera, count, x, y, scratch);
+                                      image(x, y) = pixel(lens, camera, spread, count, x, y, scratch);
                               }
                               on_tile(int(tile.rows().size() * tile.cols().size()));
                           });
@@ -99,12 +100,14 @@ public:
     }
 
 private:
-    // The path a camera ray of pixel (x, y) carries, drawing from `random`.
+    // The path a camera ray of pixel (x, y) carries, drawing from `random`. `spread` is
+    // lens.pixel_spread(), computed once a render: two square roots and a division, which each
+    // pixel waited for before its trace (14% of hw1 simple_reflectance's per-row samples).
     typename Integrator::CameraPath camera_path(const ThinLensCamera<Real>& lens, const scene::Camera& camera,
-                                                Random& random, int x, int y) const {
+                                                Real spread, Random& random, int x, int y) const {
         typename Integrator::CameraPath path{
             random, Vec2<Real>((Real(x) + Real(0.5)) / Real(lens.width()), (Real(y) + Real(0.5)) / Real(lens.height())),
-            lens.pixel_spread()};
+            spread};
         // Integrators that render cameras differently (the path tracer's RendererParams) learn
         // the camera's choice here.
         if constexpr (requires { path.renderer; }) path.renderer = camera.renderer;
@@ -119,8 +122,8 @@ private:
     // division) depend on no other pixel's, so the core overlaps them from pixel to pixel,
     // where one pixel at a time waited for them before its trace (the per-pixel lambda was
     // 14% of hw1 simple_reflectance's samples, a quarter of it on the ray's division).
-    void one_sample_row(const ThinLensCamera<Real>& lens, const scene::Camera& camera, int y, int begin, int end,
-                        Image& image) const {
+    void one_sample_row(const ThinLensCamera<Real>& lens, const scene::Camera& camera, Real spread, int y, int begin,
+                        int end, Image& image) const {
         constexpr int batch = tile_size;
         std::array<Random, batch> streams;
         std::array<Ray<Real>, batch> rays;
@@ -135,7 +138,7 @@ private:
             }
             for (int i = 0; i < n; ++i) {
                 const int x = start + i;
-                typename Integrator::CameraPath path = camera_path(lens, camera, streams[std::size_t(i)], x, y);
+                typename Integrator::CameraPath path = camera_path(lens, camera, spread, streams[std::size_t(i)], x, y);
                 image(x, y) = one_sample_pixel(integrator_.radiance(rays[std::size_t(i)], path));
             }
         }
@@ -161,11 +164,11 @@ private:
     // A pixel of several samples: every sample's ray and filter weight first, then the traces.
     // As in one_sample_row, the rays and weights depend on no trace (and draw nothing), so
     // their divisions, square roots and exponentials overlap, and the sums are the same.
-    glm::vec3 pixel(const ThinLensCamera<Real>& lens, const scene::Camera& camera, int count, int x, int y,
-                    PixelScratch& scratch) const {
+    glm::vec3 pixel(const ThinLensCamera<Real>& lens, const scene::Camera& camera, Real spread, int count, int x,
+                    int y, PixelScratch& scratch) const {
         const scene::PixelFilter filter = camera.filter;
         Random random = Random::for_pixel(x, y, settings_.seed);
-        typename Integrator::CameraPath path = camera_path(lens, camera, random, x, y);
+        typename Integrator::CameraPath path = camera_path(lens, camera, spread, random, x, y);
         camera_samples(count, random, scratch.samples, scratch.strata);
         const std::size_t n = scratch.samples.size();
         scratch.rays.resize(n);
