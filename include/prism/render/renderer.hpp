@@ -102,7 +102,8 @@ public:
 private:
     // The path a camera ray of pixel (x, y) carries, drawing from `random`. `spread` is
     // lens.pixel_spread(), computed once a render: two square roots and a division, which each
-    // pixel waited for before its trace (14% of hw1 simple_reflectance's per-row samples).
+    // pixel waited for before its trace (a fifth of the per-row samples on hw1 simple_reflectance
+    // once the rows were batched).
     typename Integrator::CameraPath camera_path(const ThinLensCamera<Real>& lens, const scene::Camera& camera,
                                                 Real spread, Random& random, int x, int y) const {
         typename Integrator::CameraPath path{
@@ -121,7 +122,8 @@ private:
     // A pixel's stream (two rounds of mix_bits, three draws) and its ray (a square root and a
     // division) depend on no other pixel's, so the core overlaps them from pixel to pixel,
     // where one pixel at a time waited for them before its trace (the per-pixel lambda was
-    // 14% of hw1 simple_reflectance's samples, a quarter of it on the ray's division).
+    // 13-14% of hw1 simple_reflectance's samples, an eighth of them on the instruction after the
+    // ray's division).
     void one_sample_row(const ThinLensCamera<Real>& lens, const scene::Camera& camera, Real spread, int y, int begin,
                         int end, Image& image) const {
         constexpr int batch = tile_size;
