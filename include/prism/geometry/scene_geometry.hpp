@@ -432,7 +432,7 @@ public:
     // Rays that leave one point by the same side start from the same origin, so the shadow rays
     // to every light can share one (the error-bounded origin of an instance was a third of
     // hw2 metal_glass_plates' time, computed again for each of its lights).
-    int spawn_side(const SurfacePoint<Real>& point, const Vec3<Real>& direction) const {
+    [[gnu::always_inline]] int spawn_side(const SurfacePoint<Real>& point, const Vec3<Real>& direction) const {
         if (point.object >= instances_.size()) return glm::dot(direction, point.object_normal) < 0;
         const Instance& instance = instances_[point.object];
         int side = instance.transformed

@@ -18,8 +18,9 @@
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
-#include <span>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -72,14 +73,19 @@ public:
         check_image(camera, width, height);
         const ThinLensCamera<Real> lens(camera, width, height);
         const int count = std::max(1, camera.num_samples);
+        const Real spread = lens.pixel_spread();
         Image image(width, height, Image::Unfilled{});  // every pixel is written below
         tbb::parallel_for(tbb::blocked_range2d<int>(0, height, tile_size, 0, width, tile_size),
                           [&](const tbb::blocked_range2d<int>& tile) {
-                              std::vector<CameraSample<Real>> samples;
-                              std::vector<Vec2<Real>> scratch;
-                              for (int y = tile.rows().begin(); y < tile.rows().end(); ++y)
+                              PixelScratch scratch;
+                              for (int y = tile.rows().begin(); y < tile.rows().end(); ++y) {
+                                  if (count == 1) {
+                                      one_sample_row(lens, camera, spread, y, tile.cols().begin(), tile.cols().end(), image);
+                                      continue;
+                                  }
                                   for (int x = tile.cols().begin(); x < tile.cols().end(); ++x)
-                                      image(x, y) = pixel(lens, camera, count, x, y, samples, scratch);
+                                      image(x, y) = pixel(lens, camera, spread, count, x, y, scratch);
+                              }
                               on_tile(int(tile.rows().size() * tile.cols().size()));
                           });
         return image;
@@ -94,35 +100,92 @@ public:
     }
 
 private:
-    glm::vec3 pixel(const ThinLensCamera<Real>& lens, const scene::Camera& camera, int count, int x, int y,
-                    std::vector<CameraSample<Real>>& samples, std::vector<Vec2<Real>>& scratch) const {
-        const scene::PixelFilter filter = camera.filter;
-        Random random = Random::for_pixel(x, y, settings_.seed);
+    // The path a camera ray of pixel (x, y) carries, drawing from `random`. `spread` is
+    // lens.pixel_spread(), computed once a render: two square roots and a division, which each
+    // pixel waited for before its trace (a fifth of the per-row samples on hw1 simple_reflectance
+    // once the rows were batched).
+    typename Integrator::CameraPath camera_path(const ThinLensCamera<Real>& lens, const scene::Camera& camera,
+                                                Real spread, Random& random, int x, int y) const {
         typename Integrator::CameraPath path{
             random, Vec2<Real>((Real(x) + Real(0.5)) / Real(lens.width()), (Real(y) + Real(0.5)) / Real(lens.height())),
-            lens.pixel_spread()};
+            spread};
         // Integrators that render cameras differently (the path tracer's RendererParams) learn
         // the camera's choice here.
         if constexpr (requires { path.renderer; }) path.renderer = camera.renderer;
-        // One sample (every hw1-hw2 camera) is drawn here without the sample vector; both filters
-        // weigh the pixel centre exactly 1 (exp(-0)), so its weight is not computed: the same sum
-        // and division as for any count, the same bits.
-        CameraSample<Real> centre;
-        std::span<const CameraSample<Real>> drawn(&centre, 1);
-        if (count == 1) {
-            centre = centre_sample<Real>(random);
-        } else {
-            camera_samples(count, random, samples, scratch);
-            drawn = samples;
+        return path;
+    }
+
+    // The pixels [begin, end) of row y with one sample each (every hw1-hw2 camera): first every
+    // pixel's stream and camera ray, then every trace. The sample is the centre (centre_sample,
+    // as camera_samples(1, ...) draws it), which both filters weigh exactly 1 (exp(-0)), so the
+    // weight is not computed: the same sum and division as for any count, the same bits.
+    // A pixel's stream (two rounds of mix_bits, three draws) and its ray (a square root and a
+    // division) depend on no other pixel's, so the core overlaps them from pixel to pixel,
+    // where one pixel at a time waited for them before its trace (the per-pixel lambda was
+    // 13-14% of hw1 simple_reflectance's samples, an eighth of them on the instruction after the
+    // ray's division).
+    void one_sample_row(const ThinLensCamera<Real>& lens, const scene::Camera& camera, Real spread, int y, int begin,
+                        int end, Image& image) const {
+        constexpr int batch = tile_size;
+        std::array<Random, batch> streams;
+        std::array<Ray<Real>, batch> rays;
+        for (int start = begin; start < end; start += batch) {
+            const int n = std::min(batch, end - start);
+            for (int i = 0; i < n; ++i) {
+                const int x = start + i;
+                streams[std::size_t(i)] = Random::for_pixel(x, y, settings_.seed);
+                const CameraSample<Real> sample = centre_sample<Real>(streams[std::size_t(i)]);
+                rays[std::size_t(i)] =
+                    stored_whole(lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time));
+            }
+            for (int i = 0; i < n; ++i) {
+                const int x = start + i;
+                typename Integrator::CameraPath path = camera_path(lens, camera, spread, streams[std::size_t(i)], x, y);
+                image(x, y) = one_sample_pixel(integrator_.radiance(rays[std::size_t(i)], path));
+            }
+        }
+    }
+
+    // A one-sample pixel's value, the sum and division of pixel() with the weight 1.
+    static glm::vec3 one_sample_pixel(const Vec3<Real>& radiance) {
+        Vec3<Real> sum(0);
+        Real weights = 0;
+        sum += Real(1) * radiance;
+        weights += Real(1);
+        return glm::vec3(sum / weights);
+    }
+
+    // What a tile's multi-sample pixels reuse, so that no pixel allocates.
+    struct PixelScratch {
+        std::vector<CameraSample<Real>> samples;
+        std::vector<Vec2<Real>> strata;
+        std::vector<Ray<Real>> rays;
+        std::vector<Real> weights;
+    };
+
+    // A pixel of several samples: every sample's ray and filter weight first, then the traces.
+    // As in one_sample_row, the rays and weights depend on no trace (and draw nothing), so
+    // their divisions, square roots and exponentials overlap, and the sums are the same.
+    glm::vec3 pixel(const ThinLensCamera<Real>& lens, const scene::Camera& camera, Real spread, int count, int x,
+                    int y, PixelScratch& scratch) const {
+        const scene::PixelFilter filter = camera.filter;
+        Random random = Random::for_pixel(x, y, settings_.seed);
+        typename Integrator::CameraPath path = camera_path(lens, camera, spread, random, x, y);
+        camera_samples(count, random, scratch.samples, scratch.strata);
+        const std::size_t n = scratch.samples.size();
+        scratch.rays.resize(n);
+        scratch.weights.resize(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            const CameraSample<Real>& sample = scratch.samples[i];
+            scratch.rays[i] =
+                stored_whole(lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time));
+            scratch.weights[i] = filter_weight(filter, sample.pixel);
         }
         Vec3<Real> sum(0);
         Real weights = 0;
-        for (const CameraSample<Real>& sample : drawn) {
-            const Ray<Real> ray =
-                stored_whole(lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time));
-            const Real weight = count == 1 ? Real(1) : filter_weight(filter, sample.pixel);
-            sum += weight * integrator_.radiance(ray, path);
-            weights += weight;
+        for (std::size_t i = 0; i < n; ++i) {
+            sum += scratch.weights[i] * integrator_.radiance(scratch.rays[i], path);
+            weights += scratch.weights[i];
         }
         return glm::vec3(sum / weights);
     }
