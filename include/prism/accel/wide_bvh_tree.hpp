@@ -146,7 +146,9 @@ public:
     // What the slab test needs of a ray, broadcast once. A two-level scene whose mesh shares
     // the world's space prepares it once per ray for both levels (geometry/scene_geometry.hpp).
     struct TraversalRay {
-        Pack origin[3], inverse_direction[3];
+        // far_inverse_direction is inverse_direction times Ize's far_scale, rounded: the
+        // widening is paid once per ray instead of once per node (see enter).
+        Pack origin[3], inverse_direction[3], far_inverse_direction[3];
         // Where the entered and the left plane of each axis start in WideBvhNode::bounds, by
         // the direction's sign: row times N, an offset the loads add without a multiply.
         std::ptrdiff_t near_plane[3], far_plane[3];
@@ -156,6 +158,7 @@ public:
             for (int axis = 0; axis < 3; ++axis) {
                 origin[axis] = Pack::broadcast(box_ray.origin[axis]);
                 inverse_direction[axis] = Pack::broadcast(box_ray.inverse_direction[axis]);
+                far_inverse_direction[axis] = Pack::broadcast(box_ray.inverse_direction[axis] * far_scale);
                 // The sign decides which plane is entered, so no per-child min/max: the same
                 // order the scalar test's swap finds (1/-0 = -inf enters by the high plane).
                 const bool negative = std::signbit(box_ray.inverse_direction[axis]);
@@ -201,29 +204,32 @@ public:
     [[gnu::always_inline]] bool enters(const TraversalRay& ray, Real t_min, Real t_max) const {
         if (nodes_.empty()) return false;
         Pack entry;
-        return enter(nodes_[0], ray, t_min, t_max, entry).any();
+        return enter(nodes_[0], ray, t_min, t_max * far_scale, entry).any();
     }
 
 private:
 
     // Every child's entry distance; the mask says which children the ray enters within
-    // [t_min, t_max]. A NaN distance (0 * inf, a ray in a slab's plane) constrains nothing,
-    // as in the scalar intersect_box.
-    [[gnu::always_inline]] static simd::Mask<Real, N> enter(const WideBvhNode<Real, N>& node, const TraversalRay& ray, Real t_min, Real t_max,
-                                     Pack& entry) {
+    // [t_min, t_max], given as t_min and far_limit = t_max * far_scale. A NaN distance (0 * inf,
+    // a ray in a slab's plane) constrains nothing, as in the scalar intersect_box.
+    // Ize's widening sits in the ray's far_inverse_direction, not in a multiply here: the node
+    // test is one latency chain from the node's load to the hit mask, which the next node's
+    // address waits on, and a multiply of the nearest exit added four cycles to it. Each exit
+    // distance is fl(fl(plane - origin) * fl(inverse_direction * far_scale)) instead of
+    // fl(fl(fl(plane - origin) * inverse_direction) * far_scale): two roundings of the same
+    // exact product either way, so the relative error bound that makes the test conservative
+    // (intersect_box's) holds unchanged; and t_max is widened as before, by one rounded product.
+    [[gnu::always_inline]] static simd::Mask<Real, N> enter(const WideBvhNode<Real, N>& node, const TraversalRay& ray, Real t_min,
+                                                            Real far_limit, Pack& entry) {
         const Real* planes = &node.bounds[0][0];
         Pack t_enter = Pack::broadcast(t_min);
-        Pack t_exit = Pack::broadcast(t_max);
+        Pack t_exit = Pack::broadcast(far_limit);
         for (int axis = 0; axis < 3; ++axis) {
             const Pack t_near = (Pack::load(planes + ray.near_plane[axis]) - ray.origin[axis]) * ray.inverse_direction[axis];
-            const Pack t_far = (Pack::load(planes + ray.far_plane[axis]) - ray.origin[axis]) * ray.inverse_direction[axis];
+            const Pack t_far = (Pack::load(planes + ray.far_plane[axis]) - ray.origin[axis]) * ray.far_inverse_direction[axis];
             t_enter = simd::max_keep(t_near, t_enter);
             t_exit = simd::min_keep(t_far, t_exit);
         }
-        // Ize's scaling applied once to the nearest exit instead of to every exit and to t_max:
-        // rounding a product by a positive constant is monotone, so the minimum of the scaled
-        // distances is the scaled minimum, bit for bit (NaN distances are skipped either way).
-        t_exit = t_exit * Pack::broadcast(far_scale);
         entry = t_enter;
         return t_enter <= t_exit;
     }
@@ -256,11 +262,14 @@ private:
         bool found = false;
         alignas(64) Real distances[N];
         std::uint32_t current = 0;  // the inner node to test next
+        // t_max widened as the box test widens exits, updated only when a leaf shortens t_max:
+        // the pops compare with it, and the node test starts from it.
+        Real far_limit = t_max * far_scale;
         for (;;) {
             const WideBvhNode<Real, N>& node = nodes_[current];
             simd::prefetch(node);
             Pack entry_distances;
-            std::uint32_t hits = enter(node, slabs, t_min, t_max, entry_distances).bits();
+            std::uint32_t hits = enter(node, slabs, t_min, far_limit, entry_distances).bits();
             PRISM_COUNT_NODE(hits);
             bool descend = false;
             if (hits != 0 && (hits & (hits - 1)) == 0) {
@@ -274,6 +283,7 @@ private:
                 if (leaf(node.child[i], node.count[i], t_max)) {
                     found = true;
                     if constexpr (AnyHit) return true;
+                    far_limit = t_max * far_scale;
                 }
             } else if (AnyHit && hits != 0) {
                 // Two or more entered, any hit: every entered leaf is tested before any inner
@@ -349,7 +359,7 @@ private:
                 // A box entered beyond the closest hit so far cannot hold a closer one (compared
                 // with the widened t_max the box test itself uses).
                 if constexpr (!AnyHit) {
-                    if (entry.distance > t_max * far_scale) continue;
+                    if (entry.distance > far_limit) continue;
                 }
                 if (entry.count == 0) {
                     current = entry.child;
@@ -360,6 +370,7 @@ private:
                 if (leaf(entry.child, entry.count, t_max)) {
                     found = true;
                     if constexpr (AnyHit) return true;
+                    far_limit = t_max * far_scale;
                 }
             }
             if (!descend) return found;
