@@ -355,7 +355,9 @@ private:
             }
             // Pop until an inner node to descend into; leaves on the way are tested at once.
             while (size > 0) {
-                const StackEntry entry = stack[--size];
+                // Read in place: a copy went through a stack temporary (two store-to-load
+                // forwards on the way to the next node's address).
+                const StackEntry& entry = stack[--size];
                 // A box entered beyond the closest hit so far cannot hold a closer one (compared
                 // with the widened t_max the box test itself uses).
                 if constexpr (!AnyHit) {
