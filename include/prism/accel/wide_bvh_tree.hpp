@@ -30,6 +30,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <stdexcept>
 #include <type_traits>
 #include <vector>
 
@@ -60,8 +61,36 @@ struct alignas(64) WideBvhNode {
     // child slot is the empty box (low +inf, high -inf): entered at +inf and left at -inf
     // whatever the direction's sign, it is missed even by a ray with t_max = inf.
     Real bounds[6][N];
-    std::uint32_t child[N];  // inner child: node index; leaf: first slot in primitive_indices
-    std::uint32_t count[N];  // leaf: primitive count; 0: inner child (or empty slot)
+    // Each child in one word, as Embree's tagged node references: one load and one register
+    // per child on the way down, and a test of its low bits tells a leaf. An inner child is
+    // its node's byte offset in the tree's node array (a multiple of the node's size, so its
+    // low bits are 0), which traversal adds to the array's address as it is, with no shift on
+    // the way to the next node's load; a leaf is first << count_bits | count, first its first
+    // slot in primitive_indices and count its primitives (1 to 2N). An empty slot holds 0.
+    std::uint32_t child[N];
+
+    static constexpr int count_bits = 5;
+    static constexpr std::uint32_t count_mask = (std::uint32_t(1) << count_bits) - 1;
+
+    static constexpr bool is_leaf_word(std::uint32_t word) { return (word & count_mask) != 0; }
+    // Leaf: its primitive count; inner child or empty slot: 0.
+    std::uint32_t count(int i) const { return child[i] & count_mask; }
+    // Inner child: its node's index; leaf: its first slot in primitive_indices.
+    std::uint32_t index(int i) const {
+        return count(i) != 0 ? child[i] >> count_bits : std::uint32_t(child[i] / sizeof(WideBvhNode));
+    }
+    // A tree whose node offsets or leaf slots do not fit the word cannot be built (more than
+    // 2^32 bytes of nodes, 16.7 million float or 8.3 million double nodes; or 2^27 slots).
+    void set_inner(int i, std::uint32_t node) {
+        if (std::uint64_t(node) * sizeof(WideBvhNode) > std::uint64_t(UINT32_MAX))
+            throw std::length_error("WideBvhTree: too many nodes for a 32-bit node offset");
+        child[i] = std::uint32_t(node * sizeof(WideBvhNode));
+    }
+    void set_leaf(int i, std::uint32_t first, std::uint32_t primitives) {
+        if (primitives == 0 || primitives > count_mask) throw std::length_error("WideBvhTree: a leaf of 0 or more than 31 primitives");
+        if (first > (UINT32_MAX >> count_bits)) throw std::length_error("WideBvhTree: too many primitive slots for a leaf reference");
+        child[i] = first << count_bits | primitives;
+    }
 };
 
 template <Scalar Real, int N>
@@ -234,11 +263,16 @@ private:
         return t_enter <= t_exit;
     }
 
+    using Node = WideBvhNode<Real, N>;
+
     struct StackEntry {
-        std::uint32_t child;
-        std::uint32_t count;  // 0: an inner node
+        std::uint32_t child;  // the node's child word
         Real distance;        // where the ray enters its box
     };
+
+    const Node& node_at(std::uint32_t offset) const {
+        return *reinterpret_cast<const Node*>(reinterpret_cast<const char*>(nodes_.data()) + offset);
+    }
 
     struct NoTouch {
         void operator()(std::uint32_t) const {}
@@ -248,10 +282,10 @@ private:
     // now (the node, or through `touch` the leaf's primitives) so that the wait overlaps them.
     template <class Touch>
     [[gnu::always_inline]] void prefetch(const StackEntry& entry, Touch& touch) const {
-        if (entry.count == 0)
-            simd::prefetch(nodes_[entry.child]);
+        if (!Node::is_leaf_word(entry.child))
+            simd::prefetch(node_at(entry.child));
         else
-            touch(entry.child);
+            touch(entry.child >> Node::count_bits);
     }
 
     template <bool AnyHit, class Leaf, class Touch = NoTouch>
@@ -261,12 +295,12 @@ private:
         int size = 0;
         bool found = false;
         alignas(64) Real distances[N];
-        std::uint32_t current = 0;  // the inner node to test next
+        std::uint32_t current = 0;  // the byte offset of the inner node to test next (the root's: 0)
         // t_max widened as the box test widens exits, updated only when a leaf shortens t_max:
         // the pops compare with it, and the node test starts from it.
         Real far_limit = t_max * far_scale;
         for (;;) {
-            const WideBvhNode<Real, N>& node = nodes_[current];
+            const Node& node = node_at(current);
             simd::prefetch(node);
             Pack entry_distances;
             std::uint32_t hits = enter(node, slabs, t_min, far_limit, entry_distances).bits();
@@ -274,13 +308,13 @@ private:
             bool descend = false;
             if (hits != 0 && (hits & (hits - 1)) == 0) {
                 // One child entered, the common case deep in the tree: no stack, no sort.
-                const int i = std::countr_zero(hits);
-                if (node.count[i] == 0) {
-                    current = node.child[i];
+                const std::uint32_t word = node.child[std::countr_zero(hits)];
+                if (!Node::is_leaf_word(word)) {
+                    current = word;
                     continue;
                 }
-                PRISM_COUNT_LEAF(node.count[i], N);
-                if (leaf(node.child[i], node.count[i], t_max)) {
+                PRISM_COUNT_LEAF(word & Node::count_mask, N);
+                if (leaf(word >> Node::count_bits, word & Node::count_mask, t_max)) {
                     found = true;
                     if constexpr (AnyHit) return true;
                     far_limit = t_max * far_scale;
@@ -294,10 +328,12 @@ private:
                 while (hits != 0) {
                     const int i = std::countr_zero(hits);
                     hits &= hits - 1;
-                    if (node.count[i] == 0) {
+                    const std::uint32_t word = node.child[i];
+                    if (!Node::is_leaf_word(word)) {
                         inner |= std::uint32_t(1) << i;
-                        simd::prefetch(nodes_[node.child[i]]);
-                    } else if (PRISM_COUNT_LEAF(node.count[i], N), leaf(node.child[i], node.count[i], t_max)) {
+                        simd::prefetch(node_at(word));
+                    } else if (PRISM_COUNT_LEAF(word & Node::count_mask, N),
+                               leaf(word >> Node::count_bits, word & Node::count_mask, t_max)) {
                         return true;
                     }
                 }
@@ -308,7 +344,7 @@ private:
                     while (inner != 0) {
                         const int i = std::countr_zero(inner);
                         inner &= inner - 1;
-                        stack[size++] = StackEntry{node.child[i], 0, Real(0)};
+                        stack[size++] = StackEntry{node.child[i], Real(0)};
                     }
                     current = node.child[last];
                     continue;
@@ -324,13 +360,13 @@ private:
                 if constexpr (!AnyHit) {
                     if (distances[first] < distances[second]) std::swap(near, far);
                 }
-                stack[size++] = StackEntry{node.child[far], node.count[far], distances[far]};
+                stack[size++] = StackEntry{node.child[far], distances[far]};
                 prefetch(stack[size - 1], touch);
-                if (node.count[near] == 0) {
+                if (!Node::is_leaf_word(node.child[near])) {
                     current = node.child[near];
                     continue;
                 }
-                stack[size++] = StackEntry{node.child[near], node.count[near], distances[near]};
+                stack[size++] = StackEntry{node.child[near], distances[near]};
             } else if (hits != 0) {
                 // Three or more entered (closest hit): each child's place on the stack is its
                 // rank, counted with two SIMD compares against every entered distance, so the
@@ -348,7 +384,7 @@ private:
                         ((own < entry_distances).bits() | ((own == entry_distances).bits() & ((std::uint32_t(1) << i) - 1))) &
                         entered;
                     StackEntry& pushed = stack[size + std::popcount(below)];
-                    pushed = StackEntry{node.child[i], node.count[i], distances[i]};
+                    pushed = StackEntry{node.child[i], distances[i]};
                     prefetch(pushed, touch);
                 }
                 size += std::popcount(entered);
@@ -363,13 +399,13 @@ private:
                 if constexpr (!AnyHit) {
                     if (entry.distance > far_limit) continue;
                 }
-                if (entry.count == 0) {
+                if (!Node::is_leaf_word(entry.child)) {
                     current = entry.child;
                     descend = true;
                     break;
                 }
-                PRISM_COUNT_LEAF(entry.count, N);
-                if (leaf(entry.child, entry.count, t_max)) {
+                PRISM_COUNT_LEAF(entry.child & Node::count_mask, N);
+                if (leaf(entry.child >> Node::count_bits, entry.child & Node::count_mask, t_max)) {
                     found = true;
                     if constexpr (AnyHit) return true;
                     far_limit = t_max * far_scale;
@@ -383,7 +419,7 @@ private:
         WideBvhNode<Real, N> node;
         for (int row = 0; row < 6; ++row)
             for (Real& plane : node.bounds[row]) plane = row < 3 ? infinity<Real> : -infinity<Real>;
-        for (int i = 0; i < N; ++i) node.child[i] = node.count[i] = 0;
+        for (int i = 0; i < N; ++i) node.child[i] = 0;
         nodes_.push_back(node);
         return std::uint32_t(nodes_.size() - 1);
     }
@@ -509,14 +545,12 @@ private:
                 auto& indices = tree.primitive_indices_;
                 const auto& binary_indices = binary.primitive_indices();
                 const Range range = ranges[i];
-                tree.nodes_[wide].child[slot] = std::uint32_t(indices.size());
-                tree.nodes_[wide].count[slot] = range.end - range.begin;
+                tree.nodes_[wide].set_leaf(slot, std::uint32_t(indices.size()), range.end - range.begin);
                 indices.insert(indices.end(), binary_indices.begin() + range.begin, binary_indices.begin() + range.end);
                 while (indices.size() % N != 0) indices.push_back(indices.back());
             } else {
                 const std::uint32_t node = collapse(i);  // may reallocate nodes_: index again
-                tree.nodes_[wide].child[slot] = node;
-                tree.nodes_[wide].count[slot] = 0;
+                tree.nodes_[wide].set_inner(slot, node);
             }
         }
     };
