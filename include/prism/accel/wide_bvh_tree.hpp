@@ -62,36 +62,32 @@ struct alignas(64) WideBvhNode {
     // whatever the direction's sign, it is missed even by a ray with t_max = inf.
     Real bounds[6][N];
     // Each child in one word, as Embree's tagged node references: one load and one register
-    // per child on the way down, and a test of its low bits tells a leaf. An inner child is
+    // per child on the way down, and a test of its lowest bit tells a leaf. An inner child is
     // its node's byte offset in the tree's node array (a multiple of the node's size, so its
-    // low bits are 0), which traversal adds to the array's address as it is, with no shift on
-    // the way to the next node's load; a leaf is first << count_bits | count, first its first
-    // slot in primitive_indices and count its primitives (1 to 2N). An empty slot holds 0.
-    std::uint32_t child[N];
+    // lowest bit is 0), which traversal adds to the array's address as it is, with no shift on
+    // the way to the next node's load; a leaf is first << 32 | count << 1 | 1, first its first
+    // slot in primitive_indices and count its primitives (any count: a leaf of primitives that
+    // cannot be split, such as many equal boxes, may hold hundreds). An empty slot holds 0.
+    // Eight 64-bit words fill the fourth line of an 8-wide float node, which the two arrays
+    // of 32-bit child indices and counts filled before: the node stays 256 bytes.
+    std::uint64_t child[N];
 
-    static constexpr int count_bits = 5;
-    static constexpr std::uint32_t count_mask = (std::uint32_t(1) << count_bits) - 1;
-
-    static constexpr bool is_leaf_word(std::uint32_t word) { return (word & count_mask) != 0; }
+    static constexpr bool is_leaf_word(std::uint64_t word) { return (word & 1) != 0; }
+    static constexpr std::uint32_t leaf_first(std::uint64_t word) { return std::uint32_t(word >> 32); }
+    static constexpr std::uint32_t leaf_count(std::uint64_t word) { return std::uint32_t(word) >> 1; }
     // Leaf: its primitive count; inner child or empty slot: 0.
-    std::uint32_t count(int i) const { return child[i] & count_mask; }
+    std::uint32_t count(int i) const { return is_leaf_word(child[i]) ? leaf_count(child[i]) : 0; }
     // Inner child: its node's index; leaf: its first slot in primitive_indices.
     std::uint32_t index(int i) const {
-        return count(i) != 0 ? child[i] >> count_bits : std::uint32_t(child[i] / sizeof(WideBvhNode));
+        return is_leaf_word(child[i]) ? leaf_first(child[i]) : std::uint32_t(child[i] / sizeof(WideBvhNode));
     }
-    // A tree whose node offsets or leaf slots do not fit the word cannot be built (more than
-    // 2^32 bytes of nodes, 16.7 million float or 8.3 million double nodes; or 2^27 slots).
-    void set_inner(int i, std::uint32_t node) {
-        if (std::uint64_t(node) * sizeof(WideBvhNode) > std::uint64_t(UINT32_MAX))
-            throw std::length_error("WideBvhTree: too many nodes for a 32-bit node offset");
-        child[i] = std::uint32_t(node * sizeof(WideBvhNode));
-    }
+    void set_inner(int i, std::uint32_t node) { child[i] = std::uint64_t(node) * sizeof(WideBvhNode); }
     void set_leaf(int i, std::uint32_t first, std::uint32_t primitives) {
-        if (primitives == 0 || primitives > count_mask) throw std::length_error("WideBvhTree: a leaf of 0 or more than 31 primitives");
-        if (first > (UINT32_MAX >> count_bits)) throw std::length_error("WideBvhTree: too many primitive slots for a leaf reference");
-        child[i] = first << count_bits | primitives;
+        if (primitives == 0 || primitives > (UINT32_MAX >> 1)) throw std::length_error("WideBvhTree: a leaf of 0 or 2^31 primitives");
+        child[i] = std::uint64_t(first) << 32 | std::uint64_t(primitives) << 1 | 1;
     }
 };
+static_assert(sizeof(WideBvhNode<float, 8>) == 256, "an 8-wide float node is four cache lines");
 
 template <Scalar Real, int N>
 class WideBvhTree {
@@ -266,11 +262,11 @@ private:
     using Node = WideBvhNode<Real, N>;
 
     struct StackEntry {
-        std::uint32_t child;  // the node's child word
+        std::uint64_t child;  // the node's child word
         Real distance;        // where the ray enters its box
     };
 
-    const Node& node_at(std::uint32_t offset) const {
+    const Node& node_at(std::uint64_t offset) const {
         return *reinterpret_cast<const Node*>(reinterpret_cast<const char*>(nodes_.data()) + offset);
     }
 
@@ -285,7 +281,7 @@ private:
         if (!Node::is_leaf_word(entry.child))
             simd::prefetch(node_at(entry.child));
         else
-            touch(entry.child >> Node::count_bits);
+            touch(Node::leaf_first(entry.child));
     }
 
     template <bool AnyHit, class Leaf, class Touch = NoTouch>
@@ -295,7 +291,7 @@ private:
         int size = 0;
         bool found = false;
         alignas(64) Real distances[N];
-        std::uint32_t current = 0;  // the byte offset of the inner node to test next (the root's: 0)
+        std::uint64_t current = 0;  // the byte offset of the inner node to test next (the root's: 0)
         // t_max widened as the box test widens exits, updated only when a leaf shortens t_max:
         // the pops compare with it, and the node test starts from it.
         Real far_limit = t_max * far_scale;
@@ -308,13 +304,13 @@ private:
             bool descend = false;
             if (hits != 0 && (hits & (hits - 1)) == 0) {
                 // One child entered, the common case deep in the tree: no stack, no sort.
-                const std::uint32_t word = node.child[std::countr_zero(hits)];
+                const std::uint64_t word = node.child[std::countr_zero(hits)];
                 if (!Node::is_leaf_word(word)) {
                     current = word;
                     continue;
                 }
-                PRISM_COUNT_LEAF(word & Node::count_mask, N);
-                if (leaf(word >> Node::count_bits, word & Node::count_mask, t_max)) {
+                PRISM_COUNT_LEAF(Node::leaf_count(word), N);
+                if (leaf(Node::leaf_first(word), Node::leaf_count(word), t_max)) {
                     found = true;
                     if constexpr (AnyHit) return true;
                     far_limit = t_max * far_scale;
@@ -328,12 +324,12 @@ private:
                 while (hits != 0) {
                     const int i = std::countr_zero(hits);
                     hits &= hits - 1;
-                    const std::uint32_t word = node.child[i];
+                    const std::uint64_t word = node.child[i];
                     if (!Node::is_leaf_word(word)) {
                         inner |= std::uint32_t(1) << i;
                         simd::prefetch(node_at(word));
-                    } else if (PRISM_COUNT_LEAF(word & Node::count_mask, N),
-                               leaf(word >> Node::count_bits, word & Node::count_mask, t_max)) {
+                    } else if (PRISM_COUNT_LEAF(Node::leaf_count(word), N),
+                               leaf(Node::leaf_first(word), Node::leaf_count(word), t_max)) {
                         return true;
                     }
                 }
@@ -404,8 +400,8 @@ private:
                     descend = true;
                     break;
                 }
-                PRISM_COUNT_LEAF(entry.child & Node::count_mask, N);
-                if (leaf(entry.child >> Node::count_bits, entry.child & Node::count_mask, t_max)) {
+                PRISM_COUNT_LEAF(Node::leaf_count(entry.child), N);
+                if (leaf(Node::leaf_first(entry.child), Node::leaf_count(entry.child), t_max)) {
                     found = true;
                     if constexpr (AnyHit) return true;
                     far_limit = t_max * far_scale;
