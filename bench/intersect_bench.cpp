@@ -580,7 +580,7 @@ struct WideLayout {
         prism::WideBvhNode<float, 8> node;
         for (int row = 0; row < 6; ++row)
             for (float& plane : node.bounds[row]) plane = row < 3 ? prism::infinity<float> : -prism::infinity<float>;
-        for (int i = 0; i < 8; ++i) node.child[i] = node.count[i] = 0;
+        for (int i = 0; i < 8; ++i) node.child[i] = 0;
         nodes.push_back(node);
         return std::uint32_t(nodes.size() - 1);
     }
@@ -594,14 +594,12 @@ struct WideLayout {
         const auto* head = static_cast<const EmbreeBuiltNode*>(built);
         if (head->leaf) {
             const auto* leaf = static_cast<const EmbreeBuiltLeaf*>(built);
-            nodes[wide].child[slot] = std::uint32_t(indices.size());
-            nodes[wide].count[slot] = head->count;
+            nodes[wide].set_leaf(slot, std::uint32_t(indices.size()), head->count);
             indices.insert(indices.end(), leaf->primitives, leaf->primitives + head->count);
             while (indices.size() % 8 != 0) indices.push_back(indices.back());
         } else {
             const std::uint32_t node = emit(static_cast<const EmbreeBuiltInner*>(built));
-            nodes[wide].child[slot] = node;
-            nodes[wide].count[slot] = 0;
+            nodes[wide].set_inner(slot, node);
         }
     }
 
@@ -1152,11 +1150,11 @@ void measure_shape(const TreeIndex& tree, std::uint32_t node, double area, doubl
         if (box.min.x > box.max.x) continue;  // an empty slot
         ++shape.children;
         const double child_area = double(box.half_area());
-        if (wide.count[slot] == 0) {
-            measure_shape(tree, wide.child[slot], child_area, root_area, shape);
+        if (wide.count(slot) == 0) {
+            measure_shape(tree, wide.index(slot), child_area, root_area, shape);
         } else {
             ++shape.leaves;
-            const std::uint32_t count = wide.count[slot];
+            const std::uint32_t count = wide.count(slot);
             ++shape.leaf_sizes[std::min<std::size_t>(count, shape.leaf_sizes.size() - 1)];
             shape.slots += (count + 7) / 8 * 8;
             shape.sah += child_area / root_area * double((count + 7) / 8);

@@ -28,6 +28,7 @@
 #include <random>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <typeinfo>
@@ -512,8 +513,7 @@ void check_same_wide_trees(const Tree& a, const Tree& b) {
     std::size_t different = 0;
     for (std::size_t i = 0; i < a.nodes().size(); ++i) {
         const auto &x = a.nodes()[i], &y = b.nodes()[i];
-        different += std::memcmp(x.bounds, y.bounds, sizeof x.bounds) != 0 || std::memcmp(x.child, y.child, sizeof x.child) != 0 ||
-                     std::memcmp(x.count, y.count, sizeof x.count) != 0;
+        different += std::memcmp(x.bounds, y.bounds, sizeof x.bounds) != 0 || std::memcmp(x.child, y.child, sizeof x.child) != 0;
     }
     CHECK(different == 0);
     CHECK(a.primitive_indices() == b.primitive_indices());
@@ -1080,11 +1080,11 @@ void check_wide_structure(const prism::WideBvhTree<Real, N>& tree, const std::ve
                 continue;
             }
             if (!contains(parent_box, box)) ++child_outside;
-            if (node.count[c] == 0) {
-                stack.push_back({node.child[c], box});
+            if (node.count(c) == 0) {
+                stack.push_back({node.index(c), box});
                 continue;
             }
-            const std::uint32_t first = node.child[c], count = node.count[c];
+            const std::uint32_t first = node.index(c), count = node.count(c);
             if (first % N != 0) ++misaligned;
             REQUIRE(first + count <= order.size());
             for (std::uint32_t slot = first; slot < first + count; ++slot) {
@@ -1140,7 +1140,7 @@ void check_wide_trees() {
         std::size_t children = 0;
         for (const auto& node : tree.nodes())
             for (int c = 0; c < N; ++c) {
-                largest = std::max(largest, node.count[c]);
+                largest = std::max(largest, node.count(c));
                 children += node.bounds[0][c] <= node.bounds[3][c] ? 1 : 0;
             }
         CHECK(largest <= 2 * N);
@@ -1156,7 +1156,7 @@ void check_wide_trees() {
             check_wide_structure(tree, *input);
             std::uint32_t largest = 0;
             for (const auto& node : tree.nodes())
-                for (int c = 0; c < N; ++c) largest = std::max(largest, node.count[c]);
+                for (int c = 0; c < N; ++c) largest = std::max(largest, node.count(c));
             CHECK(largest >= 1);
             CHECK(largest <= max_leaf_size);
         }
@@ -1272,7 +1272,7 @@ void check_touched_traversal(const std::vector<prism::Aabb<Real>>& boxes, const 
     std::set<std::uint32_t> leaf_starts;
     for (const auto& node : tree.nodes())
         for (int i = 0; i < N; ++i)
-            if (node.count[i] != 0) leaf_starts.insert(node.child[i]);
+            if (node.count(i) != 0) leaf_starts.insert(node.index(i));
     std::size_t closest_differ = 0, any_differ = 0, touched = 0, not_leaves = 0;
     const auto touch = [&](std::uint32_t first) {
         ++touched;
@@ -1394,7 +1394,6 @@ void check_tree_from_layout(const std::vector<prism::Aabb<Real>>& boxes, const s
         for (int i = 0; i < N / 2; ++i) {
             for (auto& row : node.bounds) std::swap(row[i], row[N - 1 - i]);
             std::swap(node.child[i], node.child[N - 1 - i]);
-            std::swap(node.count[i], node.count[N - 1 - i]);
         }
     }
     const Tree mirrored = Tree::from_layout(nodes, built.primitive_indices(), built.bounds());
@@ -1445,4 +1444,40 @@ TEST_CASE_TEMPLATE("Wide BVH from a given layout: traverses the layout it is giv
     const auto [boxes, rays] = sphere_boxes_and_rays<Real>(31, 53);
     check_tree_from_layout<Real, 4>(boxes, rays);
     check_tree_from_layout<Real, 8>(boxes, rays);
+}
+
+template <class Real, int N>
+void check_child_words() {
+    using Node = prism::WideBvhNode<Real, N>;
+    Node node{};
+    // Inner children: the node's index back, no count; the word is the node's byte offset.
+    node.set_inner(0, 1);
+    node.set_inner(1, 12345);
+    CHECK(node.count(0) == 0);
+    CHECK(node.index(0) == 1);
+    CHECK(node.child[0] == sizeof(Node));
+    CHECK(node.index(1) == 12345);
+    // Leaves: first slot and count back, for leaves of one and two packets.
+    for (std::uint32_t count = 1; count <= 2 * N; ++count) {
+        node.set_leaf(2, 8 * count, count);
+        CHECK(node.count(2) == count);
+        CHECK(node.index(2) == 8 * count);
+    }
+    // The whole range of slots and node indices, and counts beyond a packet's (a leaf of
+    // equal boxes is not split).
+    node.set_leaf(3, UINT32_MAX, 1000);
+    CHECK(node.index(3) == UINT32_MAX);
+    CHECK(node.count(3) == 1000);
+    node.set_inner(0, UINT32_MAX);
+    CHECK(node.index(0) == UINT32_MAX);
+    CHECK(node.count(0) == 0);
+    CHECK_THROWS_AS(node.set_leaf(3, 0, 0), std::length_error);
+    // The earlier slots are untouched by the later ones.
+    CHECK(node.index(1) == 12345);
+    CHECK(node.count(1) == 0);
+}
+
+TEST_CASE_TEMPLATE("Wide BVH node: one word per child, inner nodes and leaves read back", Real, float, double) {
+    check_child_words<Real, 4>();
+    check_child_words<Real, 8>();
 }

@@ -30,6 +30,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <stdexcept>
 #include <type_traits>
 #include <vector>
 
@@ -60,9 +61,33 @@ struct alignas(64) WideBvhNode {
     // child slot is the empty box (low +inf, high -inf): entered at +inf and left at -inf
     // whatever the direction's sign, it is missed even by a ray with t_max = inf.
     Real bounds[6][N];
-    std::uint32_t child[N];  // inner child: node index; leaf: first slot in primitive_indices
-    std::uint32_t count[N];  // leaf: primitive count; 0: inner child (or empty slot)
+    // Each child in one word, as Embree's tagged node references: one load and one register
+    // per child on the way down, and a test of its lowest bit tells a leaf. An inner child is
+    // its node's byte offset in the tree's node array (a multiple of the node's size, so its
+    // lowest bit is 0), which traversal adds to the array's address as it is, with no shift on
+    // the way to the next node's load; a leaf is first << 32 | count << 1 | 1, first its first
+    // slot in primitive_indices and count its primitives (any count: a leaf of primitives that
+    // cannot be split, such as many equal boxes, may hold hundreds). An empty slot holds 0.
+    // Eight 64-bit words fill the fourth line of an 8-wide float node, which the two arrays
+    // of 32-bit child indices and counts filled before: the node stays 256 bytes.
+    std::uint64_t child[N];
+
+    static constexpr bool is_leaf_word(std::uint64_t word) { return (word & 1) != 0; }
+    static constexpr std::uint32_t leaf_first(std::uint64_t word) { return std::uint32_t(word >> 32); }
+    static constexpr std::uint32_t leaf_count(std::uint64_t word) { return std::uint32_t(word) >> 1; }
+    // Leaf: its primitive count; inner child or empty slot: 0.
+    std::uint32_t count(int i) const { return is_leaf_word(child[i]) ? leaf_count(child[i]) : 0; }
+    // Inner child: its node's index; leaf: its first slot in primitive_indices.
+    std::uint32_t index(int i) const {
+        return is_leaf_word(child[i]) ? leaf_first(child[i]) : std::uint32_t(child[i] / sizeof(WideBvhNode));
+    }
+    void set_inner(int i, std::uint32_t node) { child[i] = std::uint64_t(node) * sizeof(WideBvhNode); }
+    void set_leaf(int i, std::uint32_t first, std::uint32_t primitives) {
+        if (primitives == 0 || primitives > (UINT32_MAX >> 1)) throw std::length_error("WideBvhTree: a leaf of 0 or 2^31 primitives");
+        child[i] = std::uint64_t(first) << 32 | std::uint64_t(primitives) << 1 | 1;
+    }
 };
+static_assert(sizeof(WideBvhNode<float, 8>) == 256, "an 8-wide float node is four cache lines");
 
 template <Scalar Real, int N>
 class WideBvhTree {
@@ -146,7 +171,9 @@ public:
     // What the slab test needs of a ray, broadcast once. A two-level scene whose mesh shares
     // the world's space prepares it once per ray for both levels (geometry/scene_geometry.hpp).
     struct TraversalRay {
-        Pack origin[3], inverse_direction[3];
+        // far_inverse_direction is inverse_direction times Ize's far_scale, rounded: the
+        // widening is paid once per ray instead of once per node (see enter).
+        Pack origin[3], inverse_direction[3], far_inverse_direction[3];
         // Where the entered and the left plane of each axis start in WideBvhNode::bounds, by
         // the direction's sign: row times N, an offset the loads add without a multiply.
         std::ptrdiff_t near_plane[3], far_plane[3];
@@ -156,6 +183,7 @@ public:
             for (int axis = 0; axis < 3; ++axis) {
                 origin[axis] = Pack::broadcast(box_ray.origin[axis]);
                 inverse_direction[axis] = Pack::broadcast(box_ray.inverse_direction[axis]);
+                far_inverse_direction[axis] = Pack::broadcast(box_ray.inverse_direction[axis] * far_scale);
                 // The sign decides which plane is entered, so no per-child min/max: the same
                 // order the scalar test's swap finds (1/-0 = -inf enters by the high plane).
                 const bool negative = std::signbit(box_ray.inverse_direction[axis]);
@@ -201,38 +229,46 @@ public:
     [[gnu::always_inline]] bool enters(const TraversalRay& ray, Real t_min, Real t_max) const {
         if (nodes_.empty()) return false;
         Pack entry;
-        return enter(nodes_[0], ray, t_min, t_max, entry).any();
+        return enter(nodes_[0], ray, t_min, t_max * far_scale, entry).any();
     }
 
 private:
 
     // Every child's entry distance; the mask says which children the ray enters within
-    // [t_min, t_max]. A NaN distance (0 * inf, a ray in a slab's plane) constrains nothing,
-    // as in the scalar intersect_box.
-    [[gnu::always_inline]] static simd::Mask<Real, N> enter(const WideBvhNode<Real, N>& node, const TraversalRay& ray, Real t_min, Real t_max,
-                                     Pack& entry) {
+    // [t_min, t_max], given as t_min and far_limit = t_max * far_scale. A NaN distance (0 * inf,
+    // a ray in a slab's plane) constrains nothing, as in the scalar intersect_box.
+    // Ize's widening sits in the ray's far_inverse_direction, not in a multiply here: the node
+    // test is one latency chain from the node's load to the hit mask, which the next node's
+    // address waits on, and a multiply of the nearest exit added four cycles to it. Each exit
+    // distance is fl(fl(plane - origin) * fl(inverse_direction * far_scale)) instead of
+    // fl(fl(fl(plane - origin) * inverse_direction) * far_scale): two roundings of the same
+    // exact product either way, so the relative error bound that makes the test conservative
+    // (intersect_box's) holds unchanged; and t_max is widened as before, by one rounded product.
+    [[gnu::always_inline]] static simd::Mask<Real, N> enter(const WideBvhNode<Real, N>& node, const TraversalRay& ray, Real t_min,
+                                                            Real far_limit, Pack& entry) {
         const Real* planes = &node.bounds[0][0];
         Pack t_enter = Pack::broadcast(t_min);
-        Pack t_exit = Pack::broadcast(t_max);
+        Pack t_exit = Pack::broadcast(far_limit);
         for (int axis = 0; axis < 3; ++axis) {
             const Pack t_near = (Pack::load(planes + ray.near_plane[axis]) - ray.origin[axis]) * ray.inverse_direction[axis];
-            const Pack t_far = (Pack::load(planes + ray.far_plane[axis]) - ray.origin[axis]) * ray.inverse_direction[axis];
+            const Pack t_far = (Pack::load(planes + ray.far_plane[axis]) - ray.origin[axis]) * ray.far_inverse_direction[axis];
             t_enter = simd::max_keep(t_near, t_enter);
             t_exit = simd::min_keep(t_far, t_exit);
         }
-        // Ize's scaling applied once to the nearest exit instead of to every exit and to t_max:
-        // rounding a product by a positive constant is monotone, so the minimum of the scaled
-        // distances is the scaled minimum, bit for bit (NaN distances are skipped either way).
-        t_exit = t_exit * Pack::broadcast(far_scale);
         entry = t_enter;
         return t_enter <= t_exit;
     }
 
+    using Node = WideBvhNode<Real, N>;
+
     struct StackEntry {
-        std::uint32_t child;
-        std::uint32_t count;  // 0: an inner node
+        std::uint64_t child;  // the node's child word
         Real distance;        // where the ray enters its box
     };
+
+    const Node& node_at(std::uint64_t offset) const {
+        return *reinterpret_cast<const Node*>(reinterpret_cast<const char*>(nodes_.data()) + offset);
+    }
 
     struct NoTouch {
         void operator()(std::uint32_t) const {}
@@ -242,10 +278,10 @@ private:
     // now (the node, or through `touch` the leaf's primitives) so that the wait overlaps them.
     template <class Touch>
     [[gnu::always_inline]] void prefetch(const StackEntry& entry, Touch& touch) const {
-        if (entry.count == 0)
-            simd::prefetch(nodes_[entry.child]);
+        if (!Node::is_leaf_word(entry.child))
+            simd::prefetch(node_at(entry.child));
         else
-            touch(entry.child);
+            touch(Node::leaf_first(entry.child));
     }
 
     template <bool AnyHit, class Leaf, class Touch = NoTouch>
@@ -255,25 +291,29 @@ private:
         int size = 0;
         bool found = false;
         alignas(64) Real distances[N];
-        std::uint32_t current = 0;  // the inner node to test next
+        std::uint64_t current = 0;  // the byte offset of the inner node to test next (the root's: 0)
+        // t_max widened as the box test widens exits, updated only when a leaf shortens t_max:
+        // the pops compare with it, and the node test starts from it.
+        Real far_limit = t_max * far_scale;
         for (;;) {
-            const WideBvhNode<Real, N>& node = nodes_[current];
+            const Node& node = node_at(current);
             simd::prefetch(node);
             Pack entry_distances;
-            std::uint32_t hits = enter(node, slabs, t_min, t_max, entry_distances).bits();
+            std::uint32_t hits = enter(node, slabs, t_min, far_limit, entry_distances).bits();
             PRISM_COUNT_NODE(hits);
             bool descend = false;
             if (hits != 0 && (hits & (hits - 1)) == 0) {
                 // One child entered, the common case deep in the tree: no stack, no sort.
-                const int i = std::countr_zero(hits);
-                if (node.count[i] == 0) {
-                    current = node.child[i];
+                const std::uint64_t word = node.child[std::countr_zero(hits)];
+                if (!Node::is_leaf_word(word)) {
+                    current = word;
                     continue;
                 }
-                PRISM_COUNT_LEAF(node.count[i], N);
-                if (leaf(node.child[i], node.count[i], t_max)) {
+                PRISM_COUNT_LEAF(Node::leaf_count(word), N);
+                if (leaf(Node::leaf_first(word), Node::leaf_count(word), t_max)) {
                     found = true;
                     if constexpr (AnyHit) return true;
+                    far_limit = t_max * far_scale;
                 }
             } else if (AnyHit && hits != 0) {
                 // Two or more entered, any hit: every entered leaf is tested before any inner
@@ -284,10 +324,12 @@ private:
                 while (hits != 0) {
                     const int i = std::countr_zero(hits);
                     hits &= hits - 1;
-                    if (node.count[i] == 0) {
+                    const std::uint64_t word = node.child[i];
+                    if (!Node::is_leaf_word(word)) {
                         inner |= std::uint32_t(1) << i;
-                        simd::prefetch(nodes_[node.child[i]]);
-                    } else if (PRISM_COUNT_LEAF(node.count[i], N), leaf(node.child[i], node.count[i], t_max)) {
+                        simd::prefetch(node_at(word));
+                    } else if (PRISM_COUNT_LEAF(Node::leaf_count(word), N),
+                               leaf(Node::leaf_first(word), Node::leaf_count(word), t_max)) {
                         return true;
                     }
                 }
@@ -298,7 +340,7 @@ private:
                     while (inner != 0) {
                         const int i = std::countr_zero(inner);
                         inner &= inner - 1;
-                        stack[size++] = StackEntry{node.child[i], 0, Real(0)};
+                        stack[size++] = StackEntry{node.child[i], Real(0)};
                     }
                     current = node.child[last];
                     continue;
@@ -314,13 +356,13 @@ private:
                 if constexpr (!AnyHit) {
                     if (distances[first] < distances[second]) std::swap(near, far);
                 }
-                stack[size++] = StackEntry{node.child[far], node.count[far], distances[far]};
+                stack[size++] = StackEntry{node.child[far], distances[far]};
                 prefetch(stack[size - 1], touch);
-                if (node.count[near] == 0) {
+                if (!Node::is_leaf_word(node.child[near])) {
                     current = node.child[near];
                     continue;
                 }
-                stack[size++] = StackEntry{node.child[near], node.count[near], distances[near]};
+                stack[size++] = StackEntry{node.child[near], distances[near]};
             } else if (hits != 0) {
                 // Three or more entered (closest hit): each child's place on the stack is its
                 // rank, counted with two SIMD compares against every entered distance, so the
@@ -338,28 +380,31 @@ private:
                         ((own < entry_distances).bits() | ((own == entry_distances).bits() & ((std::uint32_t(1) << i) - 1))) &
                         entered;
                     StackEntry& pushed = stack[size + std::popcount(below)];
-                    pushed = StackEntry{node.child[i], node.count[i], distances[i]};
+                    pushed = StackEntry{node.child[i], distances[i]};
                     prefetch(pushed, touch);
                 }
                 size += std::popcount(entered);
             }
             // Pop until an inner node to descend into; leaves on the way are tested at once.
             while (size > 0) {
-                const StackEntry entry = stack[--size];
+                // Read in place: a copy went through a stack temporary (two store-to-load
+                // forwards on the way to the next node's address).
+                const StackEntry& entry = stack[--size];
                 // A box entered beyond the closest hit so far cannot hold a closer one (compared
                 // with the widened t_max the box test itself uses).
                 if constexpr (!AnyHit) {
-                    if (entry.distance > t_max * far_scale) continue;
+                    if (entry.distance > far_limit) continue;
                 }
-                if (entry.count == 0) {
+                if (!Node::is_leaf_word(entry.child)) {
                     current = entry.child;
                     descend = true;
                     break;
                 }
-                PRISM_COUNT_LEAF(entry.count, N);
-                if (leaf(entry.child, entry.count, t_max)) {
+                PRISM_COUNT_LEAF(Node::leaf_count(entry.child), N);
+                if (leaf(Node::leaf_first(entry.child), Node::leaf_count(entry.child), t_max)) {
                     found = true;
                     if constexpr (AnyHit) return true;
+                    far_limit = t_max * far_scale;
                 }
             }
             if (!descend) return found;
@@ -370,7 +415,7 @@ private:
         WideBvhNode<Real, N> node;
         for (int row = 0; row < 6; ++row)
             for (Real& plane : node.bounds[row]) plane = row < 3 ? infinity<Real> : -infinity<Real>;
-        for (int i = 0; i < N; ++i) node.child[i] = node.count[i] = 0;
+        for (int i = 0; i < N; ++i) node.child[i] = 0;
         nodes_.push_back(node);
         return std::uint32_t(nodes_.size() - 1);
     }
@@ -496,14 +541,12 @@ private:
                 auto& indices = tree.primitive_indices_;
                 const auto& binary_indices = binary.primitive_indices();
                 const Range range = ranges[i];
-                tree.nodes_[wide].child[slot] = std::uint32_t(indices.size());
-                tree.nodes_[wide].count[slot] = range.end - range.begin;
+                tree.nodes_[wide].set_leaf(slot, std::uint32_t(indices.size()), range.end - range.begin);
                 indices.insert(indices.end(), binary_indices.begin() + range.begin, binary_indices.begin() + range.end);
                 while (indices.size() % N != 0) indices.push_back(indices.back());
             } else {
                 const std::uint32_t node = collapse(i);  // may reallocate nodes_: index again
-                tree.nodes_[wide].child[slot] = node;
-                tree.nodes_[wide].count[slot] = 0;
+                tree.nodes_[wide].set_inner(slot, node);
             }
         }
     };

@@ -128,10 +128,10 @@ public:
             int leaves = 0;
             Leaf leaf;
             for (int i = 0; i < Index::width; ++i) {
-                if (nodes[0].count[i] == 0) continue;
+                if (nodes[0].count(i) == 0) continue;
                 ++leaves;
-                leaf.first = nodes[0].child[i];
-                leaf.count = nodes[0].count[i];
+                leaf.first = nodes[0].index(i);
+                leaf.count = nodes[0].count(i);
                 for (int axis = 0; axis < 3; ++axis) {
                     leaf.box.min[axis] = nodes[0].bounds[axis][i];
                     leaf.box.max[axis] = nodes[0].bounds[3 + axis][i];
