@@ -523,12 +523,9 @@ TEST_CASE_TEMPLATE("SceneGeometry: a world-space index whose root has two leaves
             ++rays;
             prism::Ray<Real> a = ray, b = ray;
             prism::Hit<Real> hit_a, hit_b;
-            const bool found_a = culling == prism::BackfaceCulling::none
-                                     ? direct.intersect(a, hit_a)
-                                     : direct.template intersect<prism::BackfaceCulling::flat_triangles>(a, hit_a);
-            const bool found_b = culling == prism::BackfaceCulling::none
-                                     ? indexed.intersect(b, hit_b)
-                                     : indexed.template intersect<prism::BackfaceCulling::flat_triangles>(b, hit_b);
+            // As a camera ray (depth 0) under `culling`.
+            const bool found_a = prism::intersect_culled(direct, culling, 0, a, hit_a);
+            const bool found_b = prism::intersect_culled(indexed, culling, 0, b, hit_b);
             REQUIRE(found_a == found_b);
             const bool occluded = direct.occluded(ray);
             CHECK(occluded == indexed.occluded(ray));
