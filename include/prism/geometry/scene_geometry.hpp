@@ -190,7 +190,11 @@ public:
     // (geometry/backface_culling.hpp).
     template <BackfaceCulling Culling = BackfaceCulling::none>
     bool intersect(Ray<Real>& ray, Hit<Real>& hit) const {
-        if (direct_) return intersect_direct<Culling>(ray, hit, !world_meshes_.empty() && intersect_world_leaves<Culling>(ray, hit));
+        if (direct_) {
+            const bool found = !world_meshes_.empty() && (two_leaves_ ? intersect_world_leaves<Culling, true>(ray, hit)
+                                                                       : intersect_world_leaves<Culling, false>(ray, hit));
+            return intersect_direct<Culling>(ray, hit, found);
+        }
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;  // made when the ray first enters a mesh
         // The merged world-space meshes first: their hit lowers t_max before the top level
@@ -253,7 +257,9 @@ public:
 
     // Whether anything lies in (ray.t_min, ray.t_max).
     bool occluded(const Ray<Real>& ray) const {
-        if (direct_) return (!world_meshes_.empty() && occluded_world_leaves(ray)) || occluded_direct(ray);
+        if (direct_)
+            return (!world_meshes_.empty() && (two_leaves_ ? occluded_world_leaves<true>(ray) : occluded_world_leaves<false>(ray))) ||
+                   occluded_direct(ray);
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;
         std::optional<RayBoxPrecomputed<Real>> box_ray;
@@ -889,12 +895,15 @@ private:
     // and the conservative box (Ize's widened exit) fails only rays that miss the triangles.
     void choose_direct_world_meshes() {
         if (!top_objects_.empty() && !direct_top_) return;
+        bool two_leaves = false;
         for (WorldMeshes& group : world_meshes_) {
             const Mesh& index = index_of(group);
             group.leaves = index.root_leaves();
             if (!group.leaves) return;
+            two_leaves |= group.leaves->count == 2;
         }
         direct_ = true;
+        two_leaves_ = two_leaves;
     }
 
     // Whether the ray starts outside the box beyond one of its faces and does not move towards
@@ -914,7 +923,8 @@ private:
 
     // The world-space meshes' leaves for intersect's direct path: hit or not, and hit filled as
     // intersect's loop over the indices fills it.
-    template <BackfaceCulling Culling>
+    // TwoLeaves: some index has two (two_leaves_); without it, the one-leaf code alone.
+    template <BackfaceCulling Culling, bool TwoLeaves>
     bool intersect_world_leaves(Ray<Real>& ray, Hit<Real>& hit) const {
         if constexpr (Mesh::packed) {
             std::optional<TriangleRay> triangle_ray;  // made for the first leaf the ray may reach
@@ -922,8 +932,8 @@ private:
             for (const WorldMeshes& group : world_meshes_) {
                 const Mesh& index = index_of(group);
                 const bool cull = culls_back_faces(Culling, group.smooth);
-                const bool group_hit = cull ? intersect_root_leaves<true>(index, *group.leaves, ray, triangle_ray, hit)
-                                            : intersect_root_leaves<false>(index, *group.leaves, ray, triangle_ray, hit);
+                const bool group_hit = cull ? intersect_root_leaves<true, TwoLeaves>(index, *group.leaves, ray, triangle_ray, hit)
+                                            : intersect_root_leaves<false, TwoLeaves>(index, *group.leaves, ray, triangle_ray, hit);
                 if (group_hit) {
                     if (group.index) group.attribute(index.source_triangle(hit.primitive), hit);
                     else hit.object = group.objects[0];
@@ -944,12 +954,12 @@ private:
     // ends with. Only equal distances depend on the order (the later leaf wins), and the
     // traversal orders leaves by their boxes' entry distances: those rays (an edge shared by
     // the two leaves) are handed to the traversal itself, from the state before either leaf.
-    template <bool CullBackfaces>
+    template <bool CullBackfaces, bool TwoLeaves>
     [[gnu::always_inline]] static bool intersect_root_leaves(const Mesh& index, const typename Mesh::RootLeaves& leaves,
                                                              Ray<Real>& ray, std::optional<TriangleRay>& triangle_ray,
                                                              Hit<Real>& hit) {
         const auto& first = leaves.leaf[0];
-        if (leaves.count == 1) {
+        if (!TwoLeaves || leaves.count == 1) {
             if (leaves_box(first.box, ray)) return false;
             if (!triangle_ray) triangle_ray.emplace(ray);
             return index.template intersect_leaf<CullBackfaces>(ray, *triangle_ray, first, ray.t_max, hit);
@@ -977,12 +987,13 @@ private:
         return true;
     }
 
+    template <bool TwoLeaves>
     bool occluded_world_leaves(const Ray<Real>& ray) const {
         if constexpr (Mesh::packed) {
             std::optional<TriangleRay> triangle_ray;
             for (const WorldMeshes& group : world_meshes_) {
                 const Mesh& index = index_of(group);
-                for (int i = 0; i < group.leaves->count; ++i) {
+                for (int i = 0; i < (TwoLeaves ? group.leaves->count : 1); ++i) {
                     const auto& leaf = group.leaves->leaf[std::size_t(i)];
                     if (leaves_box(leaf.box, ray)) continue;
                     if (!triangle_ray) triangle_ray.emplace(ray);
@@ -1025,6 +1036,7 @@ private:
     bool direct_top_ = false;
     DirectBounds direct_bounds_;
     bool direct_ = false;  // no TraversalRay: the top level direct, the world meshes' leaves too
+    bool two_leaves_ = false;  // some world-space index of direct_ has a root of two leaves
     Aabb<Real> bounds_;
     std::vector<SphereShape<Real>> spheres_;
     std::vector<PlaneShape<Real>> planes_;
