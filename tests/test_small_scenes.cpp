@@ -14,6 +14,7 @@
 
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -424,4 +425,124 @@ TEST_CASE_TEMPLATE("Blinn-Phong: the power of exponent 1 is std::pow's, bit for 
     for (int i = 0; i < 100000; ++i) check(Real(uniform(random)));
     // A NaN cosine (a NaN half vector) stays NaN, as std::pow leaves it.
     CHECK(std::isnan(prism::blinn_phong_power(std::numeric_limits<Real>::quiet_NaN(), Real(1))));
+}
+
+namespace {
+
+// hw1 ocornellbox's room: five walls of two triangles each, all flat, merged into one
+// world-space index of ten triangles, which the build splits into a root of two leaves; two
+// spheres inside make the top level direct.
+scene::Scene two_leaf_room() {
+    scene::Scene world;
+    world.materials.push_back({});
+    world.spheres.push_back({"ball", 0, {5, -6, 1}, 4.0, glm::dmat4(1.0)});
+    world.spheres.push_back({"mirror", 0, {-5, -6, -5}, 4.0, glm::dmat4(1.0)});
+    const std::vector<glm::dvec3> corners = {{-10, -10, 10}, {10, -10, 10}, {10, 10, 10}, {-10, 10, 10},
+                                             {-10, -10, -10}, {10, -10, -10}, {10, 10, -10}, {-10, 10, -10}};
+    const std::vector<std::array<std::uint32_t, 3>> walls = {{0, 1, 5}, {5, 4, 0}, {4, 5, 6}, {6, 7, 4}, {6, 2, 3},
+                                           {3, 7, 6}, {7, 3, 0}, {7, 0, 4}, {1, 2, 6}, {1, 6, 5}};
+    for (std::size_t wall = 0; wall < walls.size(); wall += 2) {
+        scene::Mesh mesh;
+        mesh.positions = corners;
+        mesh.triangles = {walls[wall], walls[wall + 1]};
+        world.meshes.push_back(mesh);
+    }
+    return world;
+}
+
+}  // namespace
+
+TEST_CASE_TEMPLATE("SceneGeometry: a world-space index whose root has two leaves, tested leaf by leaf, finds what the index finds",
+                   Real, float, double) {
+    using Geometry = prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>;
+    using Mesh = prism::TriangleMesh<Real, prism::WideBvh<prism::Watertight, 8>>;
+    using Vec3 = prism::Vec3<Real>;
+    const scene::Scene room = two_leaf_room();
+    // The shape this test is about: the ten triangles as one index, a root of two leaves.
+    std::vector<const scene::Mesh*> parts;
+    for (const auto& mesh : room.meshes) parts.push_back(&mesh);
+    const Mesh merged{std::span<const scene::Mesh* const>(parts)};
+    const auto leaves = merged.root_leaves();
+    REQUIRE(leaves);
+    REQUIRE(leaves->count == 2);
+    CHECK(!merged.single_leaf());
+    const Geometry direct(room), indexed(past_direct_limit(room, 8));
+    REQUIRE(direct.merged_mesh_count() == 5);
+
+    std::mt19937 random(29);
+    std::uniform_real_distribution<double> uniform(-1, 1);
+    // Points on the room's edges (where two walls, often in different leaves, meet: the rays
+    // whose two hits tie), on its corners, and inside its walls.
+    const auto on_room = [&](int i) {
+        glm::dvec3 p(10 * uniform(random), 10 * uniform(random), 10 * uniform(random));
+        const int a = i % 3, b = (i + 1) % 3;
+        switch (i % 4) {
+            case 0: p[a] = (i / 4) % 2 == 0 ? -10 : 10; p[b] = (i / 8) % 2 == 0 ? -10 : 10; break;  // an edge
+            case 1: p = {(i / 4) % 2 == 0 ? -10 : 10, -10, (i / 8) % 2 == 0 ? -10 : 10}; break;  // a corner
+            default: p[a] = (i / 4) % 2 == 0 ? -10 : 10;  // a wall
+        }
+        return p;
+    };
+    const prism::BackfaceCulling cullings[] = {prism::BackfaceCulling::none, prism::BackfaceCulling::flat_triangles};
+    std::size_t rays = 0, hits = 0, wall_hits = 0, blocked = 0, edge_rays = 0;
+    for (int i = 0; i < 100000; ++i) {
+        glm::dvec3 origin, direction;
+        switch (i % 4) {
+            case 0:  // from anywhere, inside the room or out (its front is open)
+                origin = 14.0 * glm::dvec3(uniform(random), uniform(random), uniform(random));
+                direction = random_unit(random);
+                break;
+            case 1: {  // from outside, at an edge, a corner or a wall: half from the camera's side
+                // (through the open front), half from every side (the leaves' boxes entered at
+                // different distances, so that the traversal's order decides the ties)
+                const glm::dvec3 point = on_room(i / 4);
+                origin = (i / 4) % 2 == 0 ? glm::dvec3(3 * uniform(random), 3 * uniform(random), 20 + 5 * std::abs(uniform(random)))
+                                          : (25 + 5 * std::abs(uniform(random))) * random_unit(random);
+                direction = glm::normalize(point - origin);
+                ++edge_rays;
+                break;
+            }
+            case 2: {  // from inside towards an edge, a corner or a wall, some grazing
+                const glm::dvec3 point = on_room(i / 4);
+                origin = 9.0 * glm::dvec3(uniform(random), uniform(random), uniform(random));
+                direction = glm::normalize(point - origin);
+                if (i % 8 == 6) direction = glm::normalize(direction + 1e-6 * random_unit(random));
+                ++edge_rays;
+                break;
+            }
+            default: {  // from a wall, as the renderer's shadow and reflected rays leave
+                origin = on_room(4 * (i / 4) + 2 + (i / 4) % 2);
+                direction = random_unit(random);
+            }
+        }
+        prism::Ray<Real> ray{Vec3(origin), Vec3(direction), Real(i % 4 == 3 ? 1e-3 : 0), Real(60)};
+        if (i % 3 == 0) ray.t_max = Real(30 * std::abs(uniform(random)));
+        for (const prism::BackfaceCulling culling : cullings) {
+            CAPTURE(i);
+            CAPTURE(int(culling));
+            ++rays;
+            prism::Ray<Real> a = ray, b = ray;
+            prism::Hit<Real> hit_a, hit_b;
+            // As a camera ray (depth 0) under `culling`.
+            const bool found_a = prism::intersect_culled(direct, culling, 0, a, hit_a);
+            const bool found_b = prism::intersect_culled(indexed, culling, 0, b, hit_b);
+            REQUIRE(found_a == found_b);
+            const bool occluded = direct.occluded(ray);
+            CHECK(occluded == indexed.occluded(ray));
+            if (!found_a) continue;
+            ++hits;
+            blocked += occluded;
+            CHECK(same_bits(hit_a.t, hit_b.t));
+            CHECK(same_bits(a.t_max, b.t_max));
+            CHECK(same_bits(hit_a.b1, hit_b.b1));
+            CHECK(same_bits(hit_a.b2, hit_b.b2));
+            CHECK(hit_a.object == hit_b.object);
+            CHECK(hit_a.primitive == hit_b.primitive);
+            wall_hits += hit_a.object < 5;
+        }
+    }
+    CHECK(edge_rays > 40000);
+    CHECK(hits > rays / 2);
+    CHECK(wall_hits > rays / 3);
+    CHECK(blocked > rays / 3);
 }

@@ -190,7 +190,11 @@ public:
     // (geometry/backface_culling.hpp).
     template <BackfaceCulling Culling = BackfaceCulling::none>
     bool intersect(Ray<Real>& ray, Hit<Real>& hit) const {
-        if (direct_) return intersect_direct<Culling>(ray, hit, !world_meshes_.empty() && intersect_world_leaves<Culling>(ray, hit));
+        if (direct_) {
+            const bool found = !world_meshes_.empty() && (two_leaves_ ? intersect_world_leaves<Culling, true>(ray, hit)
+                                                                       : intersect_world_leaves<Culling, false>(ray, hit));
+            return intersect_direct<Culling>(ray, hit, found);
+        }
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;  // made when the ray first enters a mesh
         // The merged world-space meshes first: their hit lowers t_max before the top level
@@ -253,7 +257,9 @@ public:
 
     // Whether anything lies in (ray.t_min, ray.t_max).
     bool occluded(const Ray<Real>& ray) const {
-        if (direct_) return (!world_meshes_.empty() && occluded_world_leaves(ray)) || occluded_direct(ray);
+        if (direct_)
+            return (!world_meshes_.empty() && (two_leaves_ ? occluded_world_leaves<true>(ray) : occluded_world_leaves<false>(ray))) ||
+                   occluded_direct(ray);
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;
         std::optional<RayBoxPrecomputed<Real>> box_ray;
@@ -880,18 +886,24 @@ private:
     // triangles: the course's floors, walls and mirrors of two to six) is tested without the
     // TraversalRay: each index's leaf directly (TriangleMesh::intersect_leaf), then the spheres
     // and planes. The TraversalRay (three divisions, broadcast) and the root's box test were
-    // a fifth of hw1 simple_reflectance's profile (a two-triangle floor and one sphere). The
+    // a fifth of hw1 simple_reflectance's profile (a two-triangle floor and one sphere). An
+    // index whose root holds two leaves is tested leaf by leaf too (intersect_root_leaves:
+    // hw1 ocornellbox's ten wall triangles, where the TraversalRay, the root's test made twice
+    // and the traversal were 15% of the profile). The
     // hits are the index's: traversal of a single leaf tests that leaf, in the same slot order
     // with the same t_max; only a ray whose box test the index would fail is now tested too,
     // and the conservative box (Ize's widened exit) fails only rays that miss the triangles.
     void choose_direct_world_meshes() {
         if (!top_objects_.empty() && !direct_top_) return;
+        bool two_leaves = false;
         for (WorldMeshes& group : world_meshes_) {
             const Mesh& index = index_of(group);
-            group.leaf = index.single_leaf();
-            if (!group.leaf) return;
+            group.leaves = index.root_leaves();
+            if (!group.leaves) return;
+            two_leaves |= group.leaves->count == 2;
         }
         direct_ = true;
+        two_leaves_ = two_leaves;
     }
 
     // Whether the ray starts outside the box beyond one of its faces and does not move towards
@@ -911,18 +923,17 @@ private:
 
     // The world-space meshes' leaves for intersect's direct path: hit or not, and hit filled as
     // intersect's loop over the indices fills it.
-    template <BackfaceCulling Culling>
+    // TwoLeaves: some index has two (two_leaves_); without it, the one-leaf code alone.
+    template <BackfaceCulling Culling, bool TwoLeaves>
     bool intersect_world_leaves(Ray<Real>& ray, Hit<Real>& hit) const {
         if constexpr (Mesh::packed) {
             std::optional<TriangleRay> triangle_ray;  // made for the first leaf the ray may reach
             bool found = false;
             for (const WorldMeshes& group : world_meshes_) {
-                if (leaves_box(group.leaf->box, ray)) continue;
-                if (!triangle_ray) triangle_ray.emplace(ray);
                 const Mesh& index = index_of(group);
                 const bool cull = culls_back_faces(Culling, group.smooth);
-                const bool group_hit = cull ? index.template intersect_leaf<true>(ray, *triangle_ray, *group.leaf, ray.t_max, hit)
-                                            : index.template intersect_leaf<false>(ray, *triangle_ray, *group.leaf, ray.t_max, hit);
+                const bool group_hit = cull ? intersect_root_leaves<true, TwoLeaves>(index, *group.leaves, ray, triangle_ray, hit)
+                                            : intersect_root_leaves<false, TwoLeaves>(index, *group.leaves, ray, triangle_ray, hit);
                 if (group_hit) {
                     if (group.index) group.attribute(index.source_triangle(hit.primitive), hit);
                     else hit.object = group.objects[0];
@@ -931,18 +942,63 @@ private:
             }
             return found;
         } else {
-            return false;  // single_leaf() is empty without packets: direct_ stays false
+            return false;  // root_leaves() is empty without packets: direct_ stays false
         }
     }
 
+    // One index's closest hit from its root's one or two leaves, the hit its traversal finds.
+    // Two leaves are each tested up to the ray's own t_max, without their boxes' order: a leaf's
+    // test keeps its closest candidate at or below t_max (later slots winning ties), so under
+    // the lower t_max the nearer leaf's hit leaves the farther one, it is the same candidate
+    // where it passes, and the strictly nearer of the two hits is what either order of visits
+    // ends with. Only equal distances depend on the order (the later leaf wins), and the
+    // traversal orders leaves by their boxes' entry distances: those rays (an edge shared by
+    // the two leaves) are handed to the traversal itself, from the state before either leaf.
+    template <bool CullBackfaces, bool TwoLeaves>
+    [[gnu::always_inline]] static bool intersect_root_leaves(const Mesh& index, const typename Mesh::RootLeaves& leaves,
+                                                             Ray<Real>& ray, std::optional<TriangleRay>& triangle_ray,
+                                                             Hit<Real>& hit) {
+        const auto& first = leaves.leaf[0];
+        if (!TwoLeaves || leaves.count == 1) {
+            if (leaves_box(first.box, ray)) return false;
+            if (!triangle_ray) triangle_ray.emplace(ray);
+            return index.template intersect_leaf<CullBackfaces>(ray, *triangle_ray, first, ray.t_max, hit);
+        }
+        const auto& second = leaves.leaf[1];
+        const bool may_first = !leaves_box(first.box, ray), may_second = !leaves_box(second.box, ray);
+        if (!may_first && !may_second) return false;
+        if (!triangle_ray) triangle_ray.emplace(ray);
+        Real t_first = ray.t_max, t_second = ray.t_max;
+        Hit<Real> hit_first = hit, hit_second = hit;
+        const bool found_first =
+            may_first && index.template intersect_leaf<CullBackfaces>(ray, *triangle_ray, first, t_first, hit_first);
+        const bool found_second =
+            may_second && index.template intersect_leaf<CullBackfaces>(ray, *triangle_ray, second, t_second, hit_second);
+        if (found_first && found_second && t_first == t_second)
+            return index.template intersect<CullBackfaces>(ray, TraversalRay(ray), *triangle_ray, ray.t_max, hit);
+        if (found_second && (!found_first || t_second < t_first)) {
+            ray.t_max = t_second;
+            hit = hit_second;
+            return true;
+        }
+        if (!found_first) return false;
+        ray.t_max = t_first;
+        hit = hit_first;
+        return true;
+    }
+
+    template <bool TwoLeaves>
     bool occluded_world_leaves(const Ray<Real>& ray) const {
         if constexpr (Mesh::packed) {
             std::optional<TriangleRay> triangle_ray;
             for (const WorldMeshes& group : world_meshes_) {
-                if (leaves_box(group.leaf->box, ray)) continue;
-                if (!triangle_ray) triangle_ray.emplace(ray);
                 const Mesh& index = index_of(group);
-                if (index.occluded_leaf(ray, *triangle_ray, *group.leaf, ray.t_max)) return true;
+                for (int i = 0; i < (TwoLeaves ? group.leaves->count : 1); ++i) {
+                    const auto& leaf = group.leaves->leaf[std::size_t(i)];
+                    if (leaves_box(leaf.box, ray)) continue;
+                    if (!triangle_ray) triangle_ray.emplace(ray);
+                    if (index.occluded_leaf(ray, *triangle_ray, leaf, ray.t_max)) return true;
+                }
             }
         }
         return false;
@@ -956,7 +1012,7 @@ private:
         bool smooth = false;        // its parts' culling class
         std::vector<std::uint32_t> objects;         // per part, its object (Hit::object)
         std::vector<std::uint32_t> first_triangle;  // per part, the number of its first triangle
-        std::optional<typename Mesh::Leaf> leaf;     // the index's one leaf, when it is one (direct_)
+        std::optional<typename Mesh::RootLeaves> leaves;  // the index's leaves, when its root has only one or two (direct_)
 
         // The hit on triangle `number` of the index (hit.primitive holds the index's slot)
         // as a hit on its own mesh: its object, its triangle there (the file's order, which
@@ -980,6 +1036,7 @@ private:
     bool direct_top_ = false;
     DirectBounds direct_bounds_;
     bool direct_ = false;  // no TraversalRay: the top level direct, the world meshes' leaves too
+    bool two_leaves_ = false;  // some world-space index of direct_ has a root of two leaves
     Aabb<Real> bounds_;
     std::vector<SphereShape<Real>> spheres_;
     std::vector<PlaneShape<Real>> planes_;

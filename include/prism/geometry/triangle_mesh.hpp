@@ -122,14 +122,27 @@ public:
         Aabb<Real> box;  // the box the root's test would test (its one child's)
     };
     std::optional<Leaf> single_leaf() const {
+        const std::optional<RootLeaves> leaves = root_leaves();
+        if (leaves && leaves->count == 1) return leaves->leaf[0];
+        return std::nullopt;
+    }
+
+    // The leaves of an index whose root holds nothing but leaves, at most two of them (a wide
+    // BVH over 9 to 2N triangles, e.g. hw1 ocornellbox's ten wall triangles, which the build
+    // splits in two), in the root's slot order; none for a larger index.
+    struct RootLeaves {
+        std::array<Leaf, 2> leaf{};
+        int count = 0;
+    };
+    std::optional<RootLeaves> root_leaves() const {
         if constexpr (packed && requires { Index::width; }) {
             const auto& nodes = index_.nodes();
             if (nodes.size() != 1) return std::nullopt;
-            int leaves = 0;
-            Leaf leaf;
+            RootLeaves leaves;
             for (int i = 0; i < Index::width; ++i) {
                 if (nodes[0].count(i) == 0) continue;
-                ++leaves;
+                if (leaves.count == 2) return std::nullopt;
+                Leaf& leaf = leaves.leaf[std::size_t(leaves.count++)];
                 leaf.first = nodes[0].index(i);
                 leaf.count = nodes[0].count(i);
                 for (int axis = 0; axis < 3; ++axis) {
@@ -137,7 +150,7 @@ public:
                     leaf.box.max[axis] = nodes[0].bounds[3 + axis][i];
                 }
             }
-            if (leaves == 1) return leaf;
+            if (leaves.count > 0) return leaves;
         }
         return std::nullopt;
     }
