@@ -577,11 +577,7 @@ struct WideLayout {
     std::vector<std::uint32_t> indices;
 
     std::uint32_t new_node() {
-        prism::WideBvhNode<float, 8> node;
-        for (int row = 0; row < 6; ++row)
-            for (float& plane : node.bounds[row]) plane = row < 3 ? prism::infinity<float> : -prism::infinity<float>;
-        for (int i = 0; i < 8; ++i) node.child[i] = 0;
-        nodes.push_back(node);
+        nodes.push_back(prism::WideBvhNode<float, 8>::empty());
         return std::uint32_t(nodes.size() - 1);
     }
 

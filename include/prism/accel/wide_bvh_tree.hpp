@@ -72,6 +72,15 @@ struct alignas(64) WideBvhNode {
     // of 32-bit child indices and counts filled before: the node stays 256 bytes.
     std::uint64_t child[N];
 
+    // A node of N empty slots, filled child by child by a builder.
+    static WideBvhNode empty() {
+        WideBvhNode node;
+        for (int row = 0; row < 6; ++row)
+            for (Real& plane : node.bounds[row]) plane = row < 3 ? infinity<Real> : -infinity<Real>;
+        for (int i = 0; i < N; ++i) node.child[i] = 0;
+        return node;
+    }
+
     static constexpr bool is_leaf_word(std::uint64_t word) { return (word & 1) != 0; }
     static constexpr std::uint32_t leaf_first(std::uint64_t word) { return std::uint32_t(word >> 32); }
     static constexpr std::uint32_t leaf_count(std::uint64_t word) { return std::uint32_t(word) >> 1; }
@@ -412,11 +421,7 @@ private:
     }
 
     std::uint32_t new_node() {
-        WideBvhNode<Real, N> node;
-        for (int row = 0; row < 6; ++row)
-            for (Real& plane : node.bounds[row]) plane = row < 3 ? infinity<Real> : -infinity<Real>;
-        for (int i = 0; i < N; ++i) node.child[i] = 0;
-        nodes_.push_back(node);
+        nodes_.push_back(WideBvhNode<Real, N>::empty());
         return std::uint32_t(nodes_.size() - 1);
     }
 

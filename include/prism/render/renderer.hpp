@@ -146,14 +146,10 @@ private:
         }
     }
 
-    // A one-sample pixel's value, the sum and division of pixel() with the weight 1.
-    static glm::vec3 one_sample_pixel(const Vec3<Real>& radiance) {
-        Vec3<Real> sum(0);
-        Real weights = 0;
-        sum += Real(1) * radiance;
-        weights += Real(1);
-        return glm::vec3(sum / weights);
-    }
+    // A one-sample pixel's value: pixel()'s weighted mean with the one weight 1, whose product
+    // and division are exact. What remains is the sum's start at +0, which turns a radiance of
+    // -0 into +0 as pixel() does.
+    static glm::vec3 one_sample_pixel(const Vec3<Real>& radiance) { return glm::vec3(Vec3<Real>(0) + radiance); }
 
     // What a tile's multi-sample pixels reuse, so that no pixel allocates.
     struct PixelScratch {
