@@ -127,25 +127,6 @@ TEST_CASE("the film is black when made, small or in huge pages, and copies whole
     }
 }
 
-TEST_CASE("copied: every pixel and the size, on one thread and in runs on two") {
-    // 5 x 3 stays on the calling thread; 1024 x 768 (786,432 pixels) is three grains of
-    // image_pass_grain, split into runs.
-    for (const auto& [width, height] : {std::pair{5, 3}, std::pair{1024, 768}}) {
-        CAPTURE(width);
-        prism::Image image(width, height, prism::Image::Unfilled{});
-        for (std::size_t i = 0; i < image.pixels.size(); ++i)
-            image.pixels[i] = glm::vec3(float(i), -float(i), float(i % 977) * 0.25f);
-        for (int threads : {1, 2}) {
-            const tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
-            const prism::Image copy = prism::copied(image);
-            CHECK(copy.width == width);
-            CHECK(copy.height == height);
-            CHECK(copy.pixels == image.pixels);
-        }
-    }
-    REQUIRE(std::size_t(1024 * 768) >= 2 * prism::image_pass_grain);
-}
-
 TEST_CASE("a PPM of many row blocks and a PNG decoded in runs hold the to_8bit values") {
     // 1024 x 768: PPM rows of 3,072 bytes, so write_ppm's 64 kB blocks hold 21 rows and the image
     // takes 37 of them, the last one short; decode_image converts its 786,432 pixels in runs.

@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <vector>
 
 #ifndef PRISM_SHARED_DIR
@@ -55,7 +56,7 @@ scene::Material grey_material() {
 // A scene holding one image and one texture reading it.
 scene::Scene scene_with_image_texture(Image pixels, scene::DecalMode mode, bool high_dynamic_range = false) {
     scene::Scene scene;
-    scene.images.push_back({"in-code", std::move(pixels), high_dynamic_range});
+    scene.images.push_back({"in-code", std::make_shared<const Image>(std::move(pixels)), high_dynamic_range});
     scene::Texture texture;
     texture.kind = scene::TextureKind::image;
     texture.decal_mode = mode;
@@ -133,6 +134,25 @@ TEST_CASE_TEMPLATE("MipMap: trilinear blends the bilinear lookups of the two lev
     CHECK(double(map.trilinear(uv, std::nan("")).x) == doctest::Approx(11.0));
     CHECK(double(map.lookup(uv, 1, scene::Interpolation::bilinear).x) == doctest::Approx(11.0));  // level ignored
     CHECK(double(map.lookup(uv, 1, scene::Interpolation::trilinear).x) == doctest::Approx(11.76));
+}
+
+TEST_CASE_TEMPLATE("MipMap and TextureSet share the scene's decoded image, never copy it", Real, float, double) {
+    const auto image = std::make_shared<const Image>(grey_image(4, 2, [](int x, int y) { return x + 4 * y; }));
+    for (const bool pyramid : {false, true}) {
+        const MipMap<Real> map(image, pyramid);
+        CHECK(&map.level(0) == image.get());
+        CHECK(map.levels() == (pyramid ? 3 : 1));
+    }
+    CHECK(image.use_count() == 1);
+    // Two textures reading one image: one mip map, holding the scene's pixels.
+    scene::Scene scene = scene_with_image_texture(grey_image(3, 3, [](int x, int) { return x; }), scene::DecalMode::replace_kd);
+    scene.textures.push_back(scene.textures[0]);
+    {
+        const TextureSet<Real> set(scene);
+        CHECK(scene.images[0].pixels.use_count() == 2);
+    }
+    CHECK(scene.images[0].pixels.use_count() == 1);
+    CHECK_THROWS_AS(MipMap<Real>(std::shared_ptr<const Image>{}), std::invalid_argument);
 }
 
 TEST_CASE_TEMPLATE("MipMap: the level of detail of a ray cone", Real, float, double) {
@@ -305,7 +325,7 @@ TEST_CASE_TEMPLATE("TextureSet: replace_kd, blend_kd, replace_ks, replace_all wi
 TEST_CASE_TEMPLATE("TextureSet: degamma after normalising; HDR texels are neither normalised nor degamma'd", Real, float, double) {
     scene::Scene scene = scene_with_image_texture(grey_image(1, 1, [](int, int) { return 51; }), scene::DecalMode::replace_kd);
     scene.textures[0].degamma = true;
-    scene.images.push_back({"hdr", grey_image(1, 1, [](int, int) { return 3; }), true});
+    scene.images.push_back({"hdr", std::make_shared<const Image>(grey_image(1, 1, [](int, int) { return 3; })), true});
     scene.textures.push_back(scene.textures[0]);
     scene.textures[1].image = 1;
     const TextureSet<Real> set(scene);

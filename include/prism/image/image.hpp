@@ -3,12 +3,10 @@
 #pragma once
 
 #include <prism/memory/huge_page_allocator.hpp>
-#include <prism/parallel/for_each_run.hpp>
 
 #include <glm/glm.hpp>
 
 #include <cassert>
-#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -44,24 +42,9 @@ struct Image {
     }
 };
 
-// Pixels per run of the image passes below that run on TBB's threads: 3 MB of film, about a
-// huge page and a half, so that two threads seldom fault in the same page.
+// Pixels per run of the passes over an image that run on TBB's threads (decode_image's
+// conversion): 3 MB of film, about a huge page and a half, so that two threads seldom fault in
+// the same page.
 inline constexpr std::size_t image_pass_grain = std::size_t(1) << 18;
-
-// A copy of `image` made on TBB's threads. A texture's copy is fresh memory, 15-70 MB for the
-// course's photographs, and the kernel zeroing its pages on first touch is most of the copy's
-// time (VeachAjar's three textures: 118 MB, 7% of its samples at --scale 0.5); in runs, both
-// threads take their share of the faults.
-inline Image copied(const Image& image) {
-    Image copy;
-    copy.width = image.width;
-    copy.height = image.height;
-    copy.pixels.resize(image.pixels.size());  // default-initialised: each run writes its own pixels
-    for_each_run(image.pixels.size(), image_pass_grain, [&](std::size_t first, std::size_t end) {
-        std::copy(image.pixels.begin() + std::ptrdiff_t(first), image.pixels.begin() + std::ptrdiff_t(end),
-                  copy.pixels.begin() + std::ptrdiff_t(first));
-    });
-    return copy;
-}
 
 }  // namespace prism

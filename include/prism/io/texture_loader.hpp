@@ -30,6 +30,7 @@
 #include <initializer_list>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -217,7 +218,7 @@ private:
         scene::TextureImage image;
         image.path = path;
         try {
-            image.pixels = read_image(path);
+            image.pixels = std::make_shared<const Image>(read_image(path));
         } catch (const LoadError& error) {
             throw LoadError(reader_.file(), element.where(), error.what());
         }

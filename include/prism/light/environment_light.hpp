@@ -65,11 +65,11 @@ public:
         const std::string element = "<SphericalDirectionalLight id=\"" + light.id + "\">";
         if (light.image >= scene.images.size())
             throw io::LoadError(scene.source, element, "its image is not among the scene's images");
-        const Image& pixels = scene.images[light.image].pixels;
-        if (pixels.width <= 0 || pixels.height <= 0 ||
-            pixels.pixels.size() != std::size_t(pixels.width) * std::size_t(pixels.height))
+        const std::shared_ptr<const Image>& pixels = scene.images[light.image].pixels;
+        if (!pixels || pixels->width <= 0 || pixels->height <= 0 ||
+            pixels->pixels.size() != std::size_t(pixels->width) * std::size_t(pixels->height))
             throw io::LoadError(scene.source, element, "its image is empty");
-        return EnvironmentMap<Real>(std::make_shared<const Image>(copied(pixels)), light.layout, Vec3<Real>(light.scale));
+        return EnvironmentMap<Real>(pixels, light.layout, Vec3<Real>(light.scale));
     }
 
     LightSample<Real> sample(const ShadingFrame<Real>& at, const Vec2<Real>& u) const {

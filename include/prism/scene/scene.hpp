@@ -10,6 +10,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -173,9 +174,13 @@ struct Material {
 // An image a texture or an environment light reads, decoded once by the loader into linear
 // float RGB as stored in the file (no normalisation: an 8-bit file keeps 0..255, an HDR file
 // its radiance), so that bad or missing files fail at load time, naming the element.
+// The decoded pixels are immutable and shared, never copied: a renderer built from the scene
+// (TextureSet's mip maps, EnvironmentLight's map) holds the same image, so a photograph is in
+// memory once (VeachAjar's three JPEGs are 118 MB of floats; copying them into the renderer
+// was 3% of its whole render's CPU), and a renderer may outlive the scene it was built from.
 struct TextureImage {
     std::filesystem::path path;  // as resolved, for messages
-    Image pixels;
+    std::shared_ptr<const Image> pixels;
     bool high_dynamic_range = false;  // .hdr / .exr
 };
 

@@ -31,6 +31,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <memory>
 #include <stdexcept>
 #include <vector>
 
@@ -52,23 +53,28 @@ public:
     // box filter, so odd sizes (5x3 -> 2x1) keep the mean instead of dropping a row or column.
     // Without `pyramid` only the image itself is kept: nearest and bilinear textures never read
     // the other levels, and they cost a third more memory.
-    explicit MipMap(Image image, bool pyramid = true) {
-        if (image.width <= 0 || image.height <= 0) throw std::invalid_argument("MipMap: empty image");
+    // Level 0 is `image` itself, shared with whoever else holds it (a scene's decoded texture:
+    // scene::TextureImage), not copied.
+    explicit MipMap(std::shared_ptr<const Image> image, bool pyramid = true) {
+        if (!image || image->width <= 0 || image->height <= 0) throw std::invalid_argument("MipMap: empty image");
         levels_.push_back(std::move(image));
-        while (pyramid && (levels_.back().width > 1 || levels_.back().height > 1)) {
-            const Image& finer = levels_.back();
-            levels_.push_back(downsample_box(finer, std::max(1, finer.width / 2), std::max(1, finer.height / 2)));
+        while (pyramid && (levels_.back()->width > 1 || levels_.back()->height > 1)) {
+            const Image& finer = *levels_.back();
+            levels_.push_back(std::make_shared<const Image>(
+                downsample_box(finer, std::max(1, finer.width / 2), std::max(1, finer.height / 2))));
         }
     }
+    explicit MipMap(Image image, bool pyramid = true)
+        : MipMap(std::make_shared<const Image>(std::move(image)), pyramid) {}
 
     int levels() const { return int(levels_.size()); }
-    const Image& level(int index) const { return levels_[std::size_t(index)]; }
-    int width() const { return levels_.front().width; }
-    int height() const { return levels_.front().height; }
+    const Image& level(int index) const { return *levels_[std::size_t(index)]; }
+    int width() const { return levels_.front()->width; }
+    int height() const { return levels_.front()->height; }
 
     // The texel containing (u, v) on `level`.
     Vec3<Real> nearest(const Vec2<Real>& uv, int level = 0) const {
-        const Image& image = levels_[std::size_t(level)];
+        const Image& image = *levels_[std::size_t(level)];
         const int x = repeat(int(std::floor(uv.x * Real(image.width))), image.width);
         const int y = repeat(int(std::floor(uv.y * Real(image.height))), image.height);
         return Vec3<Real>(image(x, y));
@@ -77,7 +83,7 @@ public:
     // The four texels from (floor(u W), floor(v H)) on `level`, texel i sampled at u W = i
     // (the course's convention, see the header), weighted by the distance to each.
     Vec3<Real> bilinear(const Vec2<Real>& uv, int level = 0) const {
-        const Image& image = levels_[std::size_t(level)];
+        const Image& image = *levels_[std::size_t(level)];
         const Real x = uv.x * Real(image.width);
         const Real y = uv.y * Real(image.height);
         const Real x_floor = std::floor(x), y_floor = std::floor(y);
@@ -128,7 +134,7 @@ private:
         return wrapped < 0 ? wrapped + size : wrapped;
     }
 
-    std::vector<Image> levels_;
+    std::vector<std::shared_ptr<const Image>> levels_;
 };
 
 }  // namespace prism
