@@ -649,6 +649,12 @@ TEST_CASE("faults in textures, images and the new lights name the file and the e
         {"undecodable_image.xml", R"(<Images><Image id="1">broken.png</Image></Images>
         <TextureMap id="1" type="image"><ImageId>1</ImageId></TextureMap>)",
          "<Image id=\"1\">", "the file's content is not the png image its name says"},
+        // An <Images> block's files are decoded side by side; its first fault in file order is
+        // the one reported.
+        {"faults_among_images.xml", R"(<Images><Image id="1">textures/small.png</Image><Image id="2">nowhere.png</Image>
+        <Image id="3">broken.png</Image></Images>
+        <TextureMap id="1" type="image"><ImageId>1</ImageId></TextureMap>)",
+         "<Image id=\"2\">", "nowhere.png: no such image file"},
         {"unknown_image_format.xml", R"(<Images><Image id="1">textures/small.gif</Image></Images>)",
          "<Image id=\"1\">", "unsupported image format"},
         {"unknown_decal_mode.xml", R"(<TextureMap id="1" type="perlin"><DecalMode>replace_diffuse</DecalMode></TextureMap>)",
