@@ -264,9 +264,9 @@ TEST_CASE_TEMPLATE("Checkerboard: parity of the scaled, offset cube coordinates"
 }
 
 TEST_CASE_TEMPLATE("TextureSet: replace_kd, blend_kd, replace_ks, replace_all with the Normalizer", Real, float, double) {
-    const Image texel = grey_image(1, 1, [](int, int) { return 0; });
+    Image texel = grey_image(1, 1, [](int, int) { return 0; });
+    texel(0, 0) = glm::vec3(51, 102, 204);
     scene::Scene scene = scene_with_image_texture(texel, scene::DecalMode::replace_kd);
-    scene.images[0].pixels(0, 0) = glm::vec3(51, 102, 204);
     scene.textures.push_back(scene.textures[0]);
     scene.textures[1].decal_mode = scene::DecalMode::blend_kd;
     scene.textures.push_back(scene.textures[0]);
@@ -341,9 +341,10 @@ TEST_CASE_TEMPLATE("TextureSet: degamma after normalising; HDR texels are neithe
 
 TEST_CASE_TEMPLATE("TextureSet: replace_normal rotates the normal into the (dpdu, dpdv, N) frame", Real, float, double) {
     // (0.6, 0, 0.8) and (0, 0.6, 0.8) in [-1, 1] as texels: (c + 1) / 2 * 255.
-    scene::Scene scene = scene_with_image_texture(grey_image(2, 1, [](int, int) { return 0; }), scene::DecalMode::replace_normal);
-    scene.images[0].pixels(0, 0) = glm::vec3(1.6f, 1.0f, 1.8f) * 127.5f;
-    scene.images[0].pixels(1, 0) = glm::vec3(1.0f, 1.6f, 1.8f) * 127.5f;
+    Image texels = grey_image(2, 1, [](int, int) { return 0; });
+    texels(0, 0) = glm::vec3(1.6f, 1.0f, 1.8f) * 127.5f;
+    texels(1, 0) = glm::vec3(1.0f, 1.6f, 1.8f) * 127.5f;
+    scene::Scene scene = scene_with_image_texture(texels, scene::DecalMode::replace_normal);
     scene.textures[0].interpolation = scene::Interpolation::nearest;
     const TextureSet<Real> set(scene);
     const std::vector<std::uint32_t> textures{0};
