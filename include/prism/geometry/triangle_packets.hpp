@@ -15,6 +15,8 @@
 #include <prism/simd/pack.hpp>
 #include <prism/simd/prefetch.hpp>
 
+#include <glm/gtc/type_ptr.hpp>
+
 #include <array>
 #include <bit>
 #include <concepts>
@@ -36,22 +38,17 @@ public:
     using Prepared = typename Intersector::template Prepared<Real>;
     using Pack = simd::Pack<Storage, N>;
 
-    // What the packed test needs of a ray, broadcast once per ray. Forced inline: with the
-    // direct leaf tests (TriangleMesh::intersect_leaf) as more callers, GCC moved it out of line.
+    // What the packed test needs of a ray: the scalar test's own set-up, by reference; each
+    // use broadcasts it in the instruction (AVX-512's embedded broadcast, a load elsewhere).
+    // Packs made once per ray cost six vector stores per ray and six lines the leaf then read;
+    // a copy of the set-up was read back as one vector from the scalar stores that had just
+    // made it, which no store forwards (70% of the copy's samples, 4% of a course profile).
+    // Not copyable: a copy would outlive the ray it refers to.
     struct PackedRay {
-        int kx, ky, kz;
-        Pack origin[3];
-        Pack sx, sy, sz;
-        [[gnu::always_inline]] explicit PackedRay(const Prepared& prepared) {
-            const Watertight::Prepared<Storage>& ray = watertight_ray(prepared);
-            kx = ray.kx;
-            ky = ray.ky;
-            kz = ray.kz;
-            for (int axis = 0; axis < 3; ++axis) origin[axis] = Pack::broadcast(ray.origin[axis]);
-            sx = Pack::broadcast(ray.sx);
-            sy = Pack::broadcast(ray.sy);
-            sz = Pack::broadcast(ray.sz);
-        }
+        const Watertight::Prepared<Storage>& ray;
+        explicit PackedRay(const Prepared& prepared) : ray(watertight_ray(prepared)) {}
+        PackedRay(const PackedRay&) = delete;
+        PackedRay& operator=(const PackedRay&) = delete;
     };
 
     TrianglePackets() = default;
@@ -174,18 +171,23 @@ private:
 
     // Watertight::intersect on every lane: the lanes hit in (t_min, t_max], with their t and
     // barycentrics stored. Same operations, same order, so the same bits as the scalar test.
-    [[gnu::always_inline]] static std::uint32_t test(const Packet& packet, const PackedRay& ray, Storage t_min, Storage t_max,
+    [[gnu::always_inline]] static std::uint32_t test(const Packet& packet, const PackedRay& packed_ray, Storage t_min, Storage t_max,
                               Storage* t_out, Storage* b1_out, Storage* b2_out) {
+        const Watertight::Prepared<Storage>& ray = packed_ray.ray;
+        // Indexed as an array: glm's operator[] is a switch, which GCC kept as branches on the
+        // ray's axes in every leaf.
+        const Storage* origin = glm::value_ptr(ray.origin);
         const auto relative = [&](int vertex, int axis) {
-            return Pack::load(packet.vertices[vertex][axis]) - ray.origin[axis];
+            return Pack::load(packet.vertices[vertex][axis]) - Pack::broadcast(origin[axis]);
         };
+        const Pack sx = Pack::broadcast(ray.sx), sy = Pack::broadcast(ray.sy), sz = Pack::broadcast(ray.sz);
         const Pack a_z = relative(0, ray.kz), b_z = relative(1, ray.kz), c_z = relative(2, ray.kz);
-        const Pack ax = relative(0, ray.kx) - ray.sx * a_z;
-        const Pack ay = relative(0, ray.ky) - ray.sy * a_z;
-        const Pack bx = relative(1, ray.kx) - ray.sx * b_z;
-        const Pack by = relative(1, ray.ky) - ray.sy * b_z;
-        const Pack cx = relative(2, ray.kx) - ray.sx * c_z;
-        const Pack cy = relative(2, ray.ky) - ray.sy * c_z;
+        const Pack ax = relative(0, ray.kx) - sx * a_z;
+        const Pack ay = relative(0, ray.ky) - sy * a_z;
+        const Pack bx = relative(1, ray.kx) - sx * b_z;
+        const Pack by = relative(1, ray.ky) - sy * b_z;
+        const Pack cx = relative(2, ray.kx) - sx * c_z;
+        const Pack cy = relative(2, ray.ky) - sy * c_z;
 
         Pack u = cx * by - cy * bx;
         Pack v = ax * cy - ay * cx;
@@ -220,7 +222,7 @@ private:
         auto accepted = (!outside) & (det != zero);
         if (!accepted.any()) return 0;
 
-        const Pack az = ray.sz * a_z, bz = ray.sz * b_z, cz = ray.sz * c_z;
+        const Pack az = sz * a_z, bz = sz * b_z, cz = sz * c_z;
         const Pack t_scaled = u * az + v * bz + w * cz;
         const Pack inverse_det = Pack::broadcast(1) / det;
         const Pack t = t_scaled * inverse_det;
