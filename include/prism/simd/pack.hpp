@@ -268,10 +268,15 @@ inline constexpr bool has_fused_multiply_subtract =
 
 // a * b - c, lane by lane, rounded once. Only where has_fused_multiply_subtract<T, N>: prism
 // builds with -ffp-contract=off and fuses nowhere else (see the top of this file).
+// Declared everywhere, so that a caller's `if constexpr` branch names it; chosen only where fused.
 template <class T, int N>
     requires has_fused_multiply_subtract<T, N>
 PRISM_SIMD_INLINE inline Pack<T, N> multiply_subtract(Pack<T, N> a, Pack<T, N> b, Pack<T, N> c) {
+#if defined(PRISM_SIMD_STDX) && defined(PRISM_SIMD_X86)
     return {x86::multiply_subtract<T>(a.native, b.native, c.native)};
+#else
+    return a * b - c;  // never instantiated: the requires clause admits no Pack on this target
+#endif
 }
 
 }  // namespace prism::simd
