@@ -17,7 +17,6 @@
 #pragma once
 
 #include <prism/accel/bvh_tree.hpp>
-#include <prism/math/floating_point.hpp>
 #include <prism/memory/huge_page_allocator.hpp>
 #include <prism/simd/pack.hpp>
 #include <prism/simd/prefetch.hpp>
@@ -178,19 +177,12 @@ private:
     static constexpr Real far_scale = robust_far_scale<Real>;
 
 public:
-    // Whether the slab test takes one fused multiply-subtract per plane (see enter): where the
-    // target has FMA; elsewhere a subtract and a multiply, as the scalar intersect_box.
-    static constexpr bool fused_slabs = simd::has_fused_multiply_subtract<Real, N>;
-
     // What the slab test needs of a ray, broadcast once. A two-level scene whose mesh shares
     // the world's space prepares it once per ray for both levels (geometry/scene_geometry.hpp).
     struct TraversalRay {
         // far_inverse_direction is inverse_direction times Ize's far_scale, rounded: the
-        // widening is paid once per ray instead of once per node (see enter). near_origin and
-        // far_origin are what enter subtracts for an entry and an exit: the origin itself, or,
-        // for the fused test, the origin times each reciprocal, rounded up for the entry and
-        // down for the exit.
-        Pack near_origin[3], far_origin[3], inverse_direction[3], far_inverse_direction[3];
+        // widening is paid once per ray instead of once per node (see enter).
+        Pack origin[3], inverse_direction[3], far_inverse_direction[3];
         // Where the entered and the left plane of each axis start in WideBvhNode::bounds, by
         // the direction's sign: row times N, an offset the loads add without a multiply.
         std::ptrdiff_t near_plane[3], far_plane[3];
@@ -198,18 +190,12 @@ public:
         explicit TraversalRay(const Ray<Real>& ray) {
             const RayBoxPrecomputed<Real> box_ray(ray);
             for (int axis = 0; axis < 3; ++axis) {
-                const Real inverse = box_ray.inverse_direction[axis], far_inverse = inverse * far_scale;
-                inverse_direction[axis] = Pack::broadcast(inverse);
-                far_inverse_direction[axis] = Pack::broadcast(far_inverse);
-                if constexpr (fused_slabs) {
-                    near_origin[axis] = Pack::broadcast(next_up(box_ray.origin[axis] * inverse));
-                    far_origin[axis] = Pack::broadcast(next_down(box_ray.origin[axis] * far_inverse));
-                } else {
-                    near_origin[axis] = far_origin[axis] = Pack::broadcast(box_ray.origin[axis]);
-                }
+                origin[axis] = Pack::broadcast(box_ray.origin[axis]);
+                inverse_direction[axis] = Pack::broadcast(box_ray.inverse_direction[axis]);
+                far_inverse_direction[axis] = Pack::broadcast(box_ray.inverse_direction[axis] * far_scale);
                 // The sign decides which plane is entered, so no per-child min/max: the same
                 // order the scalar test's swap finds (1/-0 = -inf enters by the high plane).
-                const bool negative = std::signbit(inverse);
+                const bool negative = std::signbit(box_ray.inverse_direction[axis]);
                 near_plane[axis] = (negative ? 3 + axis : axis) * N;
                 far_plane[axis] = (negative ? axis : 3 + axis) * N;
             }
@@ -267,51 +253,14 @@ private:
     // fl(fl(fl(plane - origin) * inverse_direction) * far_scale): two roundings of the same
     // exact product either way, so the relative error bound that makes the test conservative
     // (intersect_box's) holds unchanged; and t_max is widened as before, by one rounded product.
-    //
-    // The fused test (fused_slabs, x86 with FMA) takes one multiply-subtract per plane, as
-    // Embree's: entry = fl(plane * inverse - near_origin), exit = fl(plane * far_inverse -
-    // far_origin), four cycles fewer on the chain than a subtract and a multiply. It is as
-    // conservative, by this argument. Let i be the rounded reciprocal and f = fl(i * far_scale)
-    // (the same floats as the unfused test uses), o the origin and p a plane, all floats; the
-    // unfused test's distances are fl(fl(p - o) * i) and fl(fl(p - o) * f). The fused test
-    // subtracts near_origin = next_up(fl(o * i)), which is >= o * i exactly (a rounding to
-    // nearest is at most half an ulp away, the step up one whole ulp; this holds for subnormal
-    // and for an overflowed product as well: next_up(inf) = inf and next_up(-inf) = -max), and
-    // far_origin = next_down(fl(o * f)) <= o * f. The multiply-subtract rounds its exact result
-    // once, and rounding is monotone, so
-    //     entry = fl(p i - near_origin) <= fl((p - o) i)   and   exit = fl(p f - far_origin) >= fl((p - o) f):
-    // each entry is at most, and each exit at least, the exact distance times the rounded
-    // reciprocal, rounded once: with T = (p - o) / d exact, an entry T >= 0 gives at most
-    // T (1 + u)^2 and an exit at least T far_scale (1 - u)^3 >= T (1 + u)^2, since far_scale =
-    // 1 + 2 gamma(3) >= (1 + u)^2 / (1 - u)^3 (u the unit roundoff); a negative T gives an entry
-    // <= 0; and far_limit = fl(t_max far_scale) >= t_max (1 + u)^2. So whenever the exact
-    // entries are at most the exact exits, t_max and t_min (>= 0), the rounded ones are too:
-    // Ize's argument, with one rounding of the product where the unfused test has two. A box
-    // the ray meets in exact arithmetic is always entered; the ulp of o * i moved into the
-    // origin's products may let a grazed box in, never keep a met one out.
-    // A zero direction component (i = +-inf): o * i is +-inf (or NaN for o = 0), and p * i -
-    // near_origin is then NaN, which constrains nothing, or +-inf of the unfused test's sign,
-    // or (near_origin = -max, far_origin = max, the next values after an infinite product)
-    // -inf for an entry and +inf for an exit, constraining less than the unfused test: each
-    // case conservative. Empty slots (+inf low, -inf high planes; their word 0 would lead back
-    // to the root) give a +inf entry and a -inf exit on every axis whose o * i is finite, and
-    // only a zero or tiny component (below |o| / max) makes it infinite: a ray's direction has
-    // a component that is neither, so an empty slot is never entered.
     [[gnu::always_inline]] static simd::Mask<Real, N> enter(const WideBvhNode<Real, N>& node, const TraversalRay& ray, Real t_min,
                                                             Real far_limit, Pack& entry) {
         const Real* planes = &node.bounds[0][0];
         Pack t_enter = Pack::broadcast(t_min);
         Pack t_exit = Pack::broadcast(far_limit);
         for (int axis = 0; axis < 3; ++axis) {
-            const Pack near = Pack::load(planes + ray.near_plane[axis]), far = Pack::load(planes + ray.far_plane[axis]);
-            Pack t_near, t_far;
-            if constexpr (fused_slabs) {
-                t_near = simd::multiply_subtract(near, ray.inverse_direction[axis], ray.near_origin[axis]);
-                t_far = simd::multiply_subtract(far, ray.far_inverse_direction[axis], ray.far_origin[axis]);
-            } else {
-                t_near = (near - ray.near_origin[axis]) * ray.inverse_direction[axis];
-                t_far = (far - ray.far_origin[axis]) * ray.far_inverse_direction[axis];
-            }
+            const Pack t_near = (Pack::load(planes + ray.near_plane[axis]) - ray.origin[axis]) * ray.inverse_direction[axis];
+            const Pack t_far = (Pack::load(planes + ray.far_plane[axis]) - ray.origin[axis]) * ray.far_inverse_direction[axis];
             t_enter = simd::max_keep(t_near, t_enter);
             t_exit = simd::min_keep(t_far, t_exit);
         }

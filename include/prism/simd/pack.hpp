@@ -127,33 +127,6 @@ PRISM_SIMD_INLINE inline auto min_max(const V& a, const V& b) {
 template <class T, class V>
 constexpr bool has_min_max = !std::is_void_v<decltype(min_max<true, T>(std::declval<const V&>(), std::declval<const V&>()))>;
 
-// a * b - c rounded once (vfmsub), where the target has FMA; void elsewhere.
-template <class T, class V>
-PRISM_SIMD_INLINE inline auto multiply_subtract([[maybe_unused]] const V& a, [[maybe_unused]] const V& b,
-                                                [[maybe_unused]] const V& c) {
-#define PRISM_SIMD_FMSUB(register_type, instruction)                                                               \
-    if constexpr (requires(const V& v) { static_cast<register_type>(v); })                                        \
-        return V(instruction(static_cast<register_type>(a), static_cast<register_type>(b), static_cast<register_type>(c)));
-#ifdef __FMA__
-    if constexpr (std::is_same_v<T, float>) {
-        PRISM_SIMD_FMSUB(__m128, _mm_fmsub_ps)
-        else PRISM_SIMD_FMSUB(__m256, _mm256_fmsub_ps)
-#ifdef __AVX512F__
-        else PRISM_SIMD_FMSUB(__m512, _mm512_fmsub_ps)
-#endif
-    } else if constexpr (std::is_same_v<T, double>) {
-        PRISM_SIMD_FMSUB(__m128d, _mm_fmsub_pd)
-        else PRISM_SIMD_FMSUB(__m256d, _mm256_fmsub_pd)
-#ifdef __AVX512F__
-        else PRISM_SIMD_FMSUB(__m512d, _mm512_fmsub_pd)
-#endif
-    }
-#endif
-#undef PRISM_SIMD_FMSUB
-}
-template <class T, class V>
-constexpr bool has_multiply_subtract =
-    !std::is_void_v<decltype(multiply_subtract<T>(std::declval<const V&>(), std::declval<const V&>(), std::declval<const V&>()))>;
 }  // namespace x86
 #endif
 
@@ -253,30 +226,6 @@ PRISM_SIMD_INLINE inline Pack<T, N> min_keep(Pack<T, N> a, Pack<T, N> b) {
     else
 #endif
         return select(a < b, a, b);
-}
-
-// Whether multiply_subtract is one fused instruction for Pack<T, N> (x86 with FMA, a Pack of
-// one register). Where it is not, callers keep their separate multiply and subtract: a fused
-// operation emulated in software would cost far more than it saves.
-template <class T, int N>
-inline constexpr bool has_fused_multiply_subtract =
-#if defined(PRISM_SIMD_STDX) && defined(PRISM_SIMD_X86)
-    x86::has_multiply_subtract<T, typename Pack<T, N>::Native>;
-#else
-    false;
-#endif
-
-// a * b - c, lane by lane, rounded once. Only where has_fused_multiply_subtract<T, N>: prism
-// builds with -ffp-contract=off and fuses nowhere else (see the top of this file).
-// Declared everywhere, so that a caller's `if constexpr` branch names it; chosen only where fused.
-template <class T, int N>
-    requires has_fused_multiply_subtract<T, N>
-PRISM_SIMD_INLINE inline Pack<T, N> multiply_subtract(Pack<T, N> a, Pack<T, N> b, Pack<T, N> c) {
-#if defined(PRISM_SIMD_STDX) && defined(PRISM_SIMD_X86)
-    return {x86::multiply_subtract<T>(a.native, b.native, c.native)};
-#else
-    return a * b - c;  // never instantiated: the requires clause admits no Pack on this target
-#endif
 }
 
 }  // namespace prism::simd
