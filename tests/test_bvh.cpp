@@ -1481,3 +1481,79 @@ TEST_CASE_TEMPLATE("Wide BVH node: one word per child, inner nodes and leaves re
     check_child_words<Real, 4>();
     check_child_words<Real, 8>();
 }
+
+namespace {
+
+// The slab test's special cases (WideBvhTree::enter): rays parallel to an axis, with +0 and -0
+// in their other components (infinite reciprocals, 0 * inf = NaN distances for an origin on a
+// plane), starting inside, outside and exactly on the boxes' face planes. Each must
+// visit every leaf whose box it meets (closed boxes, exactly: a ray parallel to the axis meets
+// the box when its other two coordinates lie within the box's), and traversal must end (an
+// empty slot, word 0, entered would lead back to the root for ever).
+template <class Real, int N>
+void check_axis_parallel_rays(int box_count) {
+    std::vector<prism::Aabb<Real>> boxes;
+    for (int i = 0; i < box_count; ++i) {
+        const Real x = Real(i % 5) - Real(2), y = Real((i / 5) % 5) - Real(2), z = Real(i / 25) - Real(1);
+        prism::Aabb<Real> box;
+        box.extend(prism::Vec3<Real>(x, y, z));
+        box.extend(prism::Vec3<Real>(x + Real(0.5), y + Real(1), z + Real(0.25)));
+        boxes.push_back(box);
+    }
+    const auto tree = prism::WideBvhTree<Real, N>::build(boxes);
+    const Real coordinates[] = {Real(-3), Real(-2), Real(-1.5), Real(-0.0), Real(0), Real(0.5), Real(0.75), Real(1), Real(2.5)};
+    const Real zeros[] = {Real(0), Real(-0.0)};
+    std::size_t rays = 0, hits = 0;
+    for (int axis = 0; axis < 3; ++axis)
+        for (const Real sign : {Real(1), Real(-1)})
+            for (const Real zero : zeros)
+                for (const Real a : coordinates)
+                    for (const Real b : coordinates)
+                        for (const Real along : {Real(-4), Real(0), Real(4)}) {
+                            prism::Ray<Real> ray;
+                            ray.direction = prism::Vec3<Real>(zero);
+                            ray.direction[axis] = sign;
+                            ray.origin[axis] = along;
+                            ray.origin[(axis + 1) % 3] = a;
+                            ray.origin[(axis + 2) % 3] = b;
+                            std::set<std::uint32_t> expected;
+                            for (std::uint32_t i = 0; i < boxes.size(); ++i) {
+                                const prism::Aabb<Real>& box = boxes[i];
+                                bool meets = true;
+                                for (int other = 1; other < 3; ++other) {
+                                    const int k = (axis + other) % 3;
+                                    meets &= box.min[k] <= ray.origin[k] && ray.origin[k] <= box.max[k];
+                                }
+                                // Ahead of the origin (t_min = 0): the box's far side along the axis.
+                                const Real far_side = sign > 0 ? box.max[axis] : box.min[axis];
+                                meets &= sign > 0 ? far_side >= along : far_side <= along;
+                                if (meets) expected.insert(i);
+                            }
+                            std::set<std::uint32_t> visited;
+                            Real t_max = ray.t_max;
+                            tree.traverse_closest(ray, t_max, [&](std::uint32_t first, std::uint32_t count, Real&) {
+                                for (std::uint32_t slot = first; slot < first + count; ++slot)
+                                    visited.insert(tree.primitive_indices()[slot]);
+                                return false;
+                            });
+                            CAPTURE(axis);
+                            CAPTURE(sign);
+                            CAPTURE(a);
+                            CAPTURE(b);
+                            CAPTURE(along);
+                            CHECK(std::includes(visited.begin(), visited.end(), expected.begin(), expected.end()));
+                            ++rays;
+                            hits += !expected.empty();
+                        }
+    CHECK(hits > 0);  // some rays meet boxes (60 of 2,916 meet the three boxes)
+}
+
+}  // namespace
+
+TEST_CASE_TEMPLATE("Wide BVH: rays parallel to an axis, on and off the boxes' planes, visit every box they meet", Real, float,
+                   double) {
+    for (const int box_count : {3, 75}) {
+        check_axis_parallel_rays<Real, 4>(box_count);
+        check_axis_parallel_rays<Real, 8>(box_count);
+    }
+}

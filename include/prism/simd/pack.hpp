@@ -12,10 +12,17 @@
 
 #include <array>
 #include <cstdint>
+#include <type_traits>
+#include <utility>
 
 #if !defined(PRISM_SIMD_SCALAR) && defined(__GLIBCXX__) && __has_include(<experimental/simd>)
 #include <experimental/simd>
 #define PRISM_SIMD_STDX 1
+#endif
+
+#if defined(PRISM_SIMD_STDX) && (defined(__x86_64__) || defined(__i386__)) && defined(__SSE2__)
+#include <immintrin.h>
+#define PRISM_SIMD_X86 1
 #endif
 
 // Every operation is forced inline: each is one instruction or two, and a call costs more (GCC
@@ -69,6 +76,59 @@ struct Pack {
         return b;
     }
 };
+
+#ifdef PRISM_SIMD_X86
+// The x86 instructions a Pack may use directly, where its native simd is one register: the
+// register type it converts to names the instruction; another width, or a Pack split over two
+// registers, converts to none and keeps the portable form. (The register types are named in
+// requires-expressions, not as template arguments, which would drop their attributes.)
+namespace x86 {
+#define PRISM_SIMD_HOLDS(register_type) requires(const V& v) { static_cast<register_type>(v); }
+#define PRISM_SIMD_MIN_MAX(register_type, max_instruction, min_instruction)                                        \
+    if constexpr (PRISM_SIMD_HOLDS(register_type)) {                                                                \
+        const register_type x = static_cast<register_type>(a), y = static_cast<register_type>(b);                  \
+        return V(maximum ? max_instruction(x, y) : min_instruction(x, y));                                         \
+    }
+
+#ifdef __AVX512F__
+// The 512-bit forms through their masked intrinsics, every lane selected: GCC 12's unmasked
+// ones start from an undefined register and warn of it under -Wall (GCC bug 105593).
+PRISM_SIMD_INLINE inline __m512 masked_max_ps(__m512 x, __m512 y) { return _mm512_mask_max_ps(x, __mmask16(-1), x, y); }
+PRISM_SIMD_INLINE inline __m512 masked_min_ps(__m512 x, __m512 y) { return _mm512_mask_min_ps(x, __mmask16(-1), x, y); }
+PRISM_SIMD_INLINE inline __m512d masked_max_pd(__m512d x, __m512d y) { return _mm512_mask_max_pd(x, __mmask8(-1), x, y); }
+PRISM_SIMD_INLINE inline __m512d masked_min_pd(__m512d x, __m512d y) { return _mm512_mask_min_pd(x, __mmask8(-1), x, y); }
+#endif
+
+// maxps(a, b) = a > b ? a : b and minps(a, b) = a < b ? a : b (pd for double); void where V
+// is no one register.
+template <bool maximum, class T, class V>
+PRISM_SIMD_INLINE inline auto min_max(const V& a, const V& b) {
+    if constexpr (std::is_same_v<T, float>) {
+        PRISM_SIMD_MIN_MAX(__m128, _mm_max_ps, _mm_min_ps)
+#ifdef __AVX__
+        else PRISM_SIMD_MIN_MAX(__m256, _mm256_max_ps, _mm256_min_ps)
+#endif
+#ifdef __AVX512F__
+        else PRISM_SIMD_MIN_MAX(__m512, masked_max_ps, masked_min_ps)
+#endif
+    } else if constexpr (std::is_same_v<T, double>) {
+        PRISM_SIMD_MIN_MAX(__m128d, _mm_max_pd, _mm_min_pd)
+#ifdef __AVX__
+        else PRISM_SIMD_MIN_MAX(__m256d, _mm256_max_pd, _mm256_min_pd)
+#endif
+#ifdef __AVX512F__
+        else PRISM_SIMD_MIN_MAX(__m512d, masked_max_pd, masked_min_pd)
+#endif
+    }
+}
+#undef PRISM_SIMD_MIN_MAX
+#undef PRISM_SIMD_HOLDS
+
+template <class T, class V>
+constexpr bool has_min_max = !std::is_void_v<decltype(min_max<true, T>(std::declval<const V&>(), std::declval<const V&>()))>;
+
+}  // namespace x86
+#endif
 
 #else
 
@@ -147,9 +207,25 @@ private:
 
 // a > b ? a : b and a < b ? a : b, lane by lane: a NaN in `a` leaves `b`, which is what the
 // slab test needs (a NaN slab distance, 0 * inf on a slab plane, constrains nothing).
+// x86's maxps and minps are exactly these (either operand NaN, or both zero: the second), in
+// one instruction; GCC compiles the select into a compare and a blend instead, and the slab
+// test chains three of them from a node's load to its mask. Where the Pack is one x86 register
+// its own instruction is used; elsewhere the select.
 template <class T, int N>
-PRISM_SIMD_INLINE inline Pack<T, N> max_keep(Pack<T, N> a, Pack<T, N> b) { return select(a > b, a, b); }
+PRISM_SIMD_INLINE inline Pack<T, N> max_keep(Pack<T, N> a, Pack<T, N> b) {
+#if defined(PRISM_SIMD_STDX) && defined(PRISM_SIMD_X86)
+    if constexpr (x86::has_min_max<T, typename Pack<T, N>::Native>) return {x86::min_max<true, T>(a.native, b.native)};
+    else
+#endif
+        return select(a > b, a, b);
+}
 template <class T, int N>
-PRISM_SIMD_INLINE inline Pack<T, N> min_keep(Pack<T, N> a, Pack<T, N> b) { return select(a < b, a, b); }
+PRISM_SIMD_INLINE inline Pack<T, N> min_keep(Pack<T, N> a, Pack<T, N> b) {
+#if defined(PRISM_SIMD_STDX) && defined(PRISM_SIMD_X86)
+    if constexpr (x86::has_min_max<T, typename Pack<T, N>::Native>) return {x86::min_max<false, T>(a.native, b.native)};
+    else
+#endif
+        return select(a < b, a, b);
+}
 
 }  // namespace prism::simd
