@@ -211,7 +211,8 @@ public:
         traverse<false>(ray, t_min, t_max, leaf);
     }
     // The same, calling touch(first) for a leaf that is entered but not tested at once, so
-    // that its primitives can be prefetched while nearer children are tested.
+    // that its primitives can be prefetched while nearer children are tested. A touch that only
+    // prefetches must be forced inline (PRISM_PREFETCH_INLINE, simd/prefetch.hpp), or GCC drops it.
     template <class Leaf, class Touch>
     void traverse_closest(const TraversalRay& ray, Real t_min, Real& t_max, Leaf&& leaf, Touch&& touch) const {
         traverse<false>(ray, t_min, t_max, leaf, touch);

@@ -193,7 +193,7 @@ public:
                                                                                  count, ray.t_min, t_limit, hit);
                 found |= leaf_hit;
                 return leaf_hit;
-            }, [&](std::uint32_t first) { packets_.prefetch(first); });
+            }, [&](std::uint32_t first) PRISM_PREFETCH_INLINE { packets_.prefetch(first); });
             return found;
         }
         bool found = false;
@@ -251,7 +251,7 @@ public:
             const typename Packets::PackedRay& packed_ray = triangle_ray.packed_ray;
             return index_.traverse_any(traversal_ray, ray.t_min, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
                 return packets_.occluded(packed_ray, first, count, ray.t_min, t_limit);
-            }, [&](std::uint32_t first) { packets_.prefetch(first); });
+            }, [&](std::uint32_t first) PRISM_PREFETCH_INLINE { packets_.prefetch(first); });
         }
         return index_.traverse_any(traversal_ray, ray.t_min, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
             for (std::uint32_t slot = first; slot < first + count; ++slot) {

@@ -129,7 +129,7 @@ public:
     }
 
     // Requests the packet that holds slot `first` (a leaf's first slot) from memory.
-    void prefetch(std::uint32_t first) const { simd::prefetch(packets_[first / N]); }
+    PRISM_PREFETCH_INLINE void prefetch(std::uint32_t first) const { simd::prefetch(packets_[first / N]); }
 
     // Whether any of slots [first, first + count) is hit in (t_min, t_limit).
     [[gnu::always_inline]] bool occluded(const PackedRay& ray, std::uint32_t first, std::uint32_t count, Real t_min, Real t_limit) const {
