@@ -188,13 +188,25 @@ public:
     // Closest hit in (ray.t_min, ray.t_max]; on a hit, ray.t_max becomes the hit distance.
     // `Culling` names the surfaces skipped when the ray meets them from behind
     // (geometry/backface_culling.hpp).
+    // The small scenes' direct form is a dispatch to two out-of-line functions, and is inlined
+    // into the caller; the indexed form stays one out-of-line function. GCC weighed the two as
+    // one: after the kernel's slab test changed size (session 12) it stopped inlining the whole,
+    // and every camera ray of the sphere scenes paid a call and its spills (3% of hw1
+    // simple_shading's CPU time, 8-13% of hw1 two_spheres').
     template <BackfaceCulling Culling = BackfaceCulling::none>
-    bool intersect(Ray<Real>& ray, Hit<Real>& hit) const {
+    [[gnu::always_inline]] bool intersect(Ray<Real>& ray, Hit<Real>& hit) const {
         if (direct_) {
             const bool found = !world_meshes_.empty() && (two_leaves_ ? intersect_world_leaves<Culling, true>(ray, hit)
                                                                        : intersect_world_leaves<Culling, false>(ray, hit));
             return intersect_direct<Culling>(ray, hit, found);
         }
+        return intersect_indexed<Culling>(ray, hit);
+    }
+
+private:
+    // intersect through the top-level index (scenes that chose no direct form).
+    template <BackfaceCulling Culling>
+    bool intersect_indexed(Ray<Real>& ray, Hit<Real>& hit) const {
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;  // made when the ray first enters a mesh
         // The merged world-space meshes first: their hit lowers t_max before the top level
@@ -232,6 +244,7 @@ public:
         return intersect_planes<Culling>(ray, hit) || found;
     }
 
+public:
     // Planes are unbounded, so no index holds them: every ray tests each one (closest hit, as
     // intersect above), eight at a time (plane_distances); the lanes are then accepted in order
     // as one plane after another would be, so the hit is the scalar loop's.
