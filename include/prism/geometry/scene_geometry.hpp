@@ -190,7 +190,7 @@ public:
     // (geometry/backface_culling.hpp).
     // The small scenes' direct form is a dispatch to two out-of-line functions, and is inlined
     // into the caller; the indexed form stays one out-of-line function. GCC weighed the two as
-    // one: after the kernel's slab test changed size (session 12) it stopped inlining the whole,
+    // one: once the kernel's slab test changed size it stopped inlining the whole,
     // and every camera ray of the sphere scenes paid a call and its spills (3% of hw1
     // simple_shading's CPU time, 8-13% of hw1 two_spheres').
     template <BackfaceCulling Culling = BackfaceCulling::none>

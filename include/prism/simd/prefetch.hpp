@@ -13,7 +13,7 @@ inline constexpr std::size_t cache_line_bytes = 64;
 // For a function, or a lambda (after its parameters), whose only effect is a prefetch, such as a
 // traversal's `touch` callback: GCC counts __builtin_prefetch as no side effect, finds such a
 // function const when it keeps it out of line, and then deletes every call to it. The wide BVH's
-// leaf prefetch had been compiled away so since it was written; forced inline, it is issued.
+// leaf prefetch had been compiled away ever since it was written; forced inline, it is issued.
 #if defined(__GNUC__) || defined(__clang__)
 #define PRISM_PREFETCH_INLINE __attribute__((always_inline))
 #else
