@@ -270,9 +270,7 @@ public:
 
     // Whether anything lies in (ray.t_min, ray.t_max).
     bool occluded(const Ray<Real>& ray) const {
-        if (direct_)
-            return (!world_meshes_.empty() && (two_leaves_ ? occluded_world_leaves<true>(ray) : occluded_world_leaves<false>(ray))) ||
-                   occluded_direct(ray);
+        if (direct_) return occluded_without_index(ray);
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;
         std::optional<RayBoxPrecomputed<Real>> box_ray;
@@ -293,6 +291,25 @@ public:
                 return false;
             });
         return blocked || occluded_by_planes(ray);
+    }
+
+    // Whether occluded_each can answer: the scenes whose shadow rays skip every index
+    // (direct_: the top level's spheres, one- or two-leaf meshes and planes tested directly).
+    bool occlusion_batches() const { return direct_; }
+
+    // Several shadow rays in one call (a point's rays to its lights): bit i set where rays[i],
+    // for bit i of `lanes`, is occluded, each answered as occluded answers it. One call per
+    // shading point rather than one per light, so that the integrator's loop over the lights
+    // holds no per-ray call for GCC to weigh against its inlining (whole9: a second call of
+    // occluded had taken it and its insides out of line in every point-lit renderer).
+    // Only for occlusion_batches().
+    std::uint32_t occluded_each(const Ray<Real>* rays, std::uint32_t lanes) const {
+        std::uint32_t blocked = 0;
+        for (; lanes != 0; lanes &= lanes - 1) {
+            const int lane = std::countr_zero(lanes);
+            if (occluded_without_index(rays[lane])) blocked |= std::uint32_t(1) << lane;
+        }
+        return blocked;
     }
 
     bool occluded_by_planes(const Ray<Real>& ray) const {
@@ -998,6 +1015,12 @@ private:
         ray.t_max = t_first;
         hit = hit_first;
         return true;
+    }
+
+    // occluded for direct_: the world meshes' leaves, then the direct top level and planes.
+    [[gnu::always_inline]] bool occluded_without_index(const Ray<Real>& ray) const {
+        return (!world_meshes_.empty() && (two_leaves_ ? occluded_world_leaves<true>(ray) : occluded_world_leaves<false>(ray))) ||
+               occluded_direct(ray);
     }
 
     template <bool TwoLeaves>
