@@ -315,27 +315,37 @@ private:
         const ShadingFrame<Real> at{position, normal};
         for (std::size_t first = 0; first < lights.size(); first += batch) {
             const std::size_t count = std::min(batch, lights.size() - first);
-            std::array<LightSample<Real>, batch> samples;
+            // Field by field: a whole LightSample or Ray copied into the arrays was read back
+            // wider than its parts had been written (a failed store forward, a fifth of hw1
+            // simple_reflectance's samples of this function).
+            std::array<Vec3<Real>, batch> directions, radiances;
             std::array<Real, batch> cosines;
             std::array<Ray<Real>, batch> shadows;
             std::uint32_t lit = 0;
             for (std::size_t i = 0; i < count; ++i) {
                 random.template skip<Real>(2);
                 const LightSample<Real> sample = lights[first + i].sample(at);
-                samples[i] = sample;
+                directions[i] = sample.direction;
+                radiances[i] = sample.radiance;
                 cosines[i] = glm::dot(normal, sample.direction);
                 if (cosines[i] <= 0) continue;
-                Ray<Real> shadow = leaving(point, normal, sample.direction, point.time, origins);
-                if (!std::isinf(sample.distance))
-                    shadow.direction = unit_vector(position + sample.direction * sample.distance - shadow.origin);
-                shadow.t_max = sample.distance;
-                shadows[i] = shadow;
+                const Ray<Real> shadow = leaving(point, normal, sample.direction, point.time, origins);
+                shadows[i].origin = shadow.origin;
+                shadows[i].direction = std::isinf(sample.distance)
+                                           ? shadow.direction
+                                           : unit_vector(position + sample.direction * sample.distance - shadow.origin);
+                shadows[i].t_min = shadow.t_min;
+                shadows[i].t_max = sample.distance;
+                shadows[i].time = shadow.time;
                 lit |= std::uint32_t(1) << i;
             }
             lit &= ~geometry_.occluded_each(shadows.data(), lit);
             for (; lit != 0; lit &= lit - 1) {
                 const std::size_t i = std::size_t(std::countr_zero(lit));
-                color += reflected(material, normal, to_viewer, samples[i], cosines[i]);
+                LightSample<Real> sample;
+                sample.direction = directions[i];
+                sample.radiance = radiances[i];
+                color += reflected(material, normal, to_viewer, sample, cosines[i]);
             }
         }
         return color;
