@@ -6,7 +6,8 @@
 // world-space meshes of a few triangles beside such a top level, tested leaf by leaf without
 // their indices (their traversal ray, their root's box test), find the same hits, ties on the
 // quads' diagonals and rays that start on or graze their boxes' faces included; and planes,
-// tested eight at a time, give what each plane's own test gives, one after another.
+// tested eight at a time, give what each plane's own test gives, one after another; and shadow
+// rays tested several at a time (occluded_each) get what each gets alone.
 #include <prism/geometry/scene_geometry.hpp>
 #include <prism/material/material.hpp>
 
@@ -15,6 +16,7 @@
 #include <doctest/doctest.h>
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -545,4 +547,60 @@ TEST_CASE_TEMPLATE("SceneGeometry: a world-space index whose root has two leaves
     CHECK(hits > rays / 2);
     CHECK(wall_hits > rays / 3);
     CHECK(blocked > rays / 3);
+}
+
+// Shadow rays tested several at a time (SceneGeometry::occluded_each, a point's rays to its
+// lights): every ray of a batch, for any set of lanes, gets what occluded gives it alone, in the
+// scenes above (direct spheres of each kind, planes, one-leaf world meshes, transformed
+// top-level plates), from points on and near the surfaces and in open space.
+TEST_CASE_TEMPLATE("SceneGeometry: shadow rays tested several at a time get what each gets alone", Real, float, double) {
+    using Geometry = prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>;
+    for (int kind = 0; kind < 3; ++kind) {
+        CAPTURE(kind);
+        const scene::Scene world = kind == 2 ? tiny_meshes() : few_spheres(kind == 1, kind == 1);
+        const Geometry geometry(world);
+        REQUIRE(geometry.occlusion_batches());
+
+        std::mt19937 random(11);
+        std::uniform_real_distribution<double> uniform(-1, 1), fraction(0, 1);
+        const std::array<glm::dvec3, 8> lights = {glm::dvec3(0, 4, 0), {3, 3, 2},     {-3, 2, -2},  {0.5, 1.2, 0.1},
+                                                  {4.5, -1, 3},        {-4, 3.5, 3},  {1, -1.2, -3}, {0, 0, 5}};
+        std::size_t blocked = 0, rays = 0;
+        for (int batch = 0; batch < 6000; ++batch) {
+            // A point on or near a sphere, on or near the floor's height, or in open space.
+            glm::dvec3 from;
+            if (batch % 3 == 0) {
+                const scene::Sphere& sphere = world.spheres[std::size_t(batch / 3) % world.spheres.size()];
+                from = glm::dvec3(sphere.transform * glm::dvec4(sphere.center + sphere.radius * random_unit(random), 1.0));
+                from += 1e-4 * random_unit(random);
+            } else if (batch % 3 == 1) {
+                from = {4 * uniform(random), -1.5 + 1e-4 * uniform(random), 4 * uniform(random)};
+            } else {
+                from = 5.0 * glm::dvec3(uniform(random), uniform(random), uniform(random));
+            }
+            std::array<prism::Ray<Real>, 8> shadows;
+            std::uint32_t lanes = 0;
+            for (std::size_t i = 0; i < lights.size(); ++i) {
+                if (fraction(random) < 0.25) continue;
+                const glm::dvec3 to_light = lights[i] - from;
+                prism::Ray<Real> ray{prism::Vec3<Real>(from), prism::Vec3<Real>(glm::normalize(to_light)), Real(0),
+                                     Real(glm::length(to_light))};
+                if (batch % 7 == 0) ray.direction = prism::Vec3<Real>(random_unit(random));
+                if (batch % 11 == 0) ray.t_min = Real(1e-3);
+                shadows[i] = ray;
+                lanes |= std::uint32_t(1) << i;
+            }
+            std::uint32_t expected = 0;
+            for (std::uint32_t rest = lanes; rest != 0; rest &= rest - 1) {
+                const int lane = std::countr_zero(rest);
+                if (geometry.occluded(shadows[std::size_t(lane)])) expected |= std::uint32_t(1) << lane;
+                ++rays;
+            }
+            CHECK(geometry.occluded_each(shadows.data(), lanes) == expected);
+            blocked += std::size_t(std::popcount(expected));
+        }
+        // Both answers are common: the comparison is not of misses (or of hits) alone.
+        CHECK(blocked > rays / 10);
+        CHECK(blocked < rays * 9 / 10);
+    }
 }
