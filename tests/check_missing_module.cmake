@@ -1,34 +1,22 @@
 # The prism renderer copied away from its Embree module (render_scene.hpp, PRISM_EMBREE_MODULE):
 # --accelerator embree must fail with exit 1, exactly one line on stderr naming the module, and
-# no image written; the same copy renders the scene with prism's own accelerator.
+# no image written (check_bad_input.cmake's checks); the same copy renders the scene with prism's
+# own accelerator.
 #   cmake -DPRISM=... -DSCENE=... -DWORK_DIR=... -P check_missing_module.cmake
 file(REMOVE_RECURSE "${WORK_DIR}")
 file(MAKE_DIRECTORY "${WORK_DIR}/bin")
 file(COPY "${PRISM}" DESTINATION "${WORK_DIR}/bin")
 get_filename_component(name "${PRISM}" NAME)
-set(copy "${WORK_DIR}/bin/${name}")
-execute_process(COMMAND "${copy}" "${SCENE}" --accelerator embree --output-dir "${WORK_DIR}/embree" --quiet
-                RESULT_VARIABLE result ERROR_VARIABLE errors OUTPUT_VARIABLE output)
-message(STATUS "exit: ${result}\nstderr: ${errors}")
+set(PRISM "${WORK_DIR}/bin/${name}")
+set(EXTRA_ARGS --accelerator embree)
+set(EXPECT_FILE "prism-embree.so")
+set(EXPECT_ELEMENT "the Embree module .* is missing")
+set(OUTPUT_DIR "${WORK_DIR}/embree")
+include(${CMAKE_CURRENT_LIST_DIR}/check_bad_input.cmake)
 if(NOT result EQUAL 1)
   message(FATAL_ERROR "expected exit 1 without the Embree module, got ${result}")
 endif()
-string(STRIP "${errors}" errors)
-string(REGEX MATCHALL "\n" newlines "${errors}")
-list(LENGTH newlines extra_lines)
-if(NOT extra_lines EQUAL 0)
-  message(FATAL_ERROR "expected one line on stderr, got ${extra_lines} more")
-endif()
-if(NOT errors MATCHES "Embree module .*prism-embree.so.* is missing")
-  message(FATAL_ERROR "the message does not name the missing module")
-endif()
-if(EXISTS "${WORK_DIR}/embree")
-  file(GLOB_RECURSE written "${WORK_DIR}/embree/*")
-  if(written)
-    message(FATAL_ERROR "files were written: ${written}")
-  endif()
-endif()
-execute_process(COMMAND "${copy}" "${SCENE}" --output-dir "${WORK_DIR}/prism" --quiet RESULT_VARIABLE result)
+execute_process(COMMAND "${PRISM}" "${SCENE}" --output-dir "${WORK_DIR}/prism" --quiet RESULT_VARIABLE result)
 if(NOT result EQUAL 0)
   message(FATAL_ERROR "without the module, prism's own accelerator failed too (${result})")
 endif()
