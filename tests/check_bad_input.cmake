@@ -2,8 +2,9 @@
 # exactly one line on stderr naming the scene (or asset) file and the element at fault, no crash
 # and no image file left behind.
 #   cmake -DPRISM=... -DSCENE=... -DEXPECT_FILE=... -DEXPECT_ELEMENT=... -DOUTPUT_DIR=... -P check_bad_input.cmake
+# (EXTRA_ARGS: more options for prism, for scripts that include this one.)
 file(REMOVE_RECURSE "${OUTPUT_DIR}")
-execute_process(COMMAND "${PRISM}" "${SCENE}" --output-dir "${OUTPUT_DIR}" --quiet
+execute_process(COMMAND "${PRISM}" "${SCENE}" --output-dir "${OUTPUT_DIR}" --quiet ${EXTRA_ARGS}
                 RESULT_VARIABLE result ERROR_VARIABLE errors OUTPUT_VARIABLE output)
 message(STATUS "exit: ${result}\nstderr: ${errors}")
 if(NOT result MATCHES "^[0-9]+$")

@@ -373,8 +373,25 @@ public:
     // object_error zero, which only spawn_origin reads: rays that leave by the scene's epsilon
     // (45 of the 57 hw1-hw2 course scenes) never call it, and a triangle's spawn point (its
     // error bound, in double) was 5% of a small scene's time.
+    // The renderers without textures (Parametrised false: hw1's scenes) have it inlined into
+    // their trace, where the fields they never read (tangents, texture frame and positions) are
+    // not stored at all; out of line it was a call per hit and a 200-byte record written whole.
     template <bool Parametrised = true>
+        requires(Parametrised)
     SurfacePoint<Real> surface(const Ray<Real>& ray, const Hit<Real>& hit, bool spawn_point = true) const {
+        return surface_of<true>(ray, hit, spawn_point);
+    }
+    template <bool Parametrised>
+        requires(!Parametrised)
+    [[gnu::always_inline]] SurfacePoint<Real> surface(const Ray<Real>& ray, const Hit<Real>& hit,
+                                                      bool spawn_point = true) const {
+        return surface_of<false>(ray, hit, spawn_point);
+    }
+
+private:
+    template <bool Parametrised>
+    [[gnu::always_inline]] SurfacePoint<Real> surface_of(const Ray<Real>& ray, const Hit<Real>& hit,
+                                                         bool spawn_point) const {
         SurfacePoint<Real> point;
         point.position = ray.at(hit.t);
         point.object = hit.object;
@@ -438,6 +455,8 @@ public:
         point.shading_normal = shading_normal;
         return point;
     }
+
+public:
 
     // The origin of a ray leaving `point` (from surface()) towards `direction`: the exact hit
     // point pushed past its error bound along the geometric normal, to the side the ray leaves

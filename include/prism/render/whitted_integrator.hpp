@@ -85,8 +85,9 @@ inline constexpr bool textured = !std::is_same_v<Textures, NoTextures<Real>>;
 // The surface point at a hit, with (u, v) and tangents only where textures may read them, and
 // the exact point with its error bound only where rays leave by it (RayOffset::error_bound). An
 // index from outside (accel/embree.hpp) fills everything.
+// Inlined into trace, so that surface<false> is (SceneGeometry::surface).
 template <bool Textured, Scalar Real, class Geometry>
-SurfacePoint<Real> shading_surface(const Geometry& geometry, const Ray<Real>& ray, const Hit<Real>& hit,
+[[gnu::always_inline]] inline SurfacePoint<Real> shading_surface(const Geometry& geometry, const Ray<Real>& ray, const Hit<Real>& hit,
                                    RayOffset offset) {
     const bool spawn_point = offset == RayOffset::error_bound;
     if constexpr (requires { geometry.template surface<Textured>(ray, hit, spawn_point); })
