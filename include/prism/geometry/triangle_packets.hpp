@@ -189,8 +189,9 @@ private:
         [[gnu::always_inline]] explicit LeafRay(const Watertight::Prepared<Storage>& ray)
             : origin_x(Pack::broadcast(glm::value_ptr(ray.origin)[ray.kx])),
               origin_y(Pack::broadcast(glm::value_ptr(ray.origin)[ray.ky])),
-              origin_z(Pack::broadcast(glm::value_ptr(ray.origin)[ray.kz])), sx(Pack::broadcast(ray.sx)), sy(Pack::broadcast(ray.sy)),
-              sz(Pack::broadcast(ray.sz)), row_x(row_offset(ray.kx)), row_y(row_offset(ray.ky)), row_z(row_offset(ray.kz)) {}
+              origin_z(Pack::broadcast(glm::value_ptr(ray.origin)[ray.kz])),
+              sx(Pack::broadcast(ray.sx)), sy(Pack::broadcast(ray.sy)), sz(Pack::broadcast(ray.sz)),
+              row_x(row_offset(ray.kx)), row_y(row_offset(ray.ky)), row_z(row_offset(ray.kz)) {}
         // Indexed as an array: glm's operator[] is a switch, which GCC kept as branches.
         static std::size_t row_offset(int axis) { return std::size_t(axis) * N * sizeof(Storage); }
     };
