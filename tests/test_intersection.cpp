@@ -18,6 +18,7 @@
 #include <limits>
 #include <random>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -126,6 +127,38 @@ TEST_CASE_TEMPLATE("max_dimension picks the largest component", Real, float, dou
     CHECK(prism::max_dimension(V(1, 3, 2)) == 1);
     CHECK(prism::max_dimension(V(1, 2, 3)) == 2);
     CHECK(prism::max_dimension(glm::abs(V(0.5, -0.2, -4))) == 2);
+}
+
+// Watertight::Prepared picks its axes without branches; they and its shear must be those of the
+// paper's branching set-up, written out here, on ties, zeros, signed zeros and NaNs too.
+TEST_CASE_TEMPLATE("Watertight::Prepared: the paper's axes and shear, ties, zeros and NaNs included", Real, float, double) {
+    using V = prism::Vec3<Real>;
+    std::vector<V> directions;
+    const Real nan = std::numeric_limits<Real>::quiet_NaN();
+    const Real values[] = {Real(0), Real(-0.0), Real(1), Real(-1), Real(2), Real(-2), Real(0.5), nan};
+    for (Real x : values)
+        for (Real y : values)
+            for (Real z : values) directions.push_back(V(x, y, z));
+    std::mt19937 random(11);
+    std::uniform_real_distribution<Real> component(Real(-1), Real(1));
+    for (int i = 0; i < 2000; ++i) directions.push_back(V(component(random), component(random), component(random)));
+
+    for (const V& d : directions) {
+        const prism::Watertight::Prepared<Real> prepared(make_ray(V(1, 2, 3), d));
+        int kz = prism::max_dimension(glm::abs(d));
+        int kx = kz == 2 ? 0 : kz + 1;
+        int ky = kx == 2 ? 0 : kx + 1;
+        if (d[kz] < 0) std::swap(kx, ky);
+        const Real expected[3] = {d[kx] / d[kz], d[ky] / d[kz], Real(1) / d[kz]};
+        const Real shear[3] = {prepared.sx, prepared.sy, prepared.sz};
+        CAPTURE(d.x);
+        CAPTURE(d.y);
+        CAPTURE(d.z);
+        CHECK(prepared.kx == kx);
+        CHECK(prepared.ky == ky);
+        CHECK(prepared.kz == kz);
+        CHECK(std::memcmp(shear, expected, sizeof(shear)) == 0);  // to the bit, NaNs included
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

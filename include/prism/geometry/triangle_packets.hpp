@@ -12,6 +12,7 @@
 #include <prism/geometry/hit.hpp>
 #include <prism/geometry/watertight.hpp>
 #include <prism/parallel/for_each_run.hpp>
+#include <prism/simd/opaque.hpp>
 #include <prism/simd/pack.hpp>
 #include <prism/simd/prefetch.hpp>
 
@@ -20,6 +21,7 @@
 #include <array>
 #include <bit>
 #include <concepts>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <type_traits>
@@ -97,9 +99,10 @@ public:
     [[gnu::always_inline]] bool intersect(const PackedRay& ray, const Vec3<Real>& direction, std::uint32_t first, std::uint32_t count,
                    Real t_min, Real& t_limit, Hit<Real>& hit) const {
         bool found = false;
+        const LeafRay leaf_ray(ray.ray);
         for (std::uint32_t base = first; base < first + count; base += N) {
             alignas(64) Storage t[N], b1[N], b2[N];
-            std::uint32_t lanes = test(packets_[base / N], ray, Storage(t_min), Storage(t_limit), t, b1, b2);
+            std::uint32_t lanes = test(packets_[base / N], leaf_ray, Storage(t_min), Storage(t_limit), t, b1, b2);
             lanes &= lane_mask(first + count - base);
             while (lanes != 0) {
                 const int lane = std::countr_zero(lanes);
@@ -133,9 +136,10 @@ public:
 
     // Whether any of slots [first, first + count) is hit in (t_min, t_limit).
     [[gnu::always_inline]] bool occluded(const PackedRay& ray, std::uint32_t first, std::uint32_t count, Real t_min, Real t_limit) const {
+        const LeafRay leaf_ray(ray.ray);
         for (std::uint32_t base = first; base < first + count; base += N) {
             alignas(64) Storage t[N], b1[N], b2[N];
-            std::uint32_t lanes = test(packets_[base / N], ray, Storage(t_min), Storage(t_limit), t, b1, b2);
+            std::uint32_t lanes = test(packets_[base / N], leaf_ray, Storage(t_min), Storage(t_limit), t, b1, b2);
             lanes &= lane_mask(first + count - base);
             while (lanes != 0) {
                 const int lane = std::countr_zero(lanes);
@@ -171,23 +175,47 @@ private:
 
     // Watertight::intersect on every lane: the lanes hit in (t_min, t_max], with their t and
     // barycentrics stored. Same operations, same order, so the same bits as the scalar test.
-    [[gnu::always_inline]] static std::uint32_t test(const Packet& packet, const PackedRay& packed_ray, Storage t_min, Storage t_max,
+    // The ray's set-up as a leaf's packet loop reads it, made once per leaf before the loop:
+    // the origin's components and the shear broadcast, and each permuted axis's row as one byte
+    // offset into a packet, its three vertices' rows at constant displacements from it. Indexed
+    // by the ray's axes inside the loop, GCC had kept nine row offsets (vertex x axis) and three
+    // origin addresses live across it and spilled them to vector registers (a tenth of the
+    // leaf's samples); read inside the loop, the origin was also read again after every hit's
+    // stores, which may alias it.
+    struct LeafRay {
+        Pack origin_x, origin_y, origin_z;  // along kx, ky, kz
+        Pack sx, sy, sz;
+        std::size_t row_x, row_y, row_z;  // bytes from a packet's start to vertex 0's row along kx, ky, kz
+        [[gnu::always_inline]] explicit LeafRay(const Watertight::Prepared<Storage>& ray)
+            : origin_x(Pack::broadcast(glm::value_ptr(ray.origin)[ray.kx])),
+              origin_y(Pack::broadcast(glm::value_ptr(ray.origin)[ray.ky])),
+              origin_z(Pack::broadcast(glm::value_ptr(ray.origin)[ray.kz])),
+              sx(Pack::broadcast(ray.sx)), sy(Pack::broadcast(ray.sy)), sz(Pack::broadcast(ray.sz)),
+              row_x(row_offset(ray.kx)), row_y(row_offset(ray.ky)), row_z(row_offset(ray.kz)) {}
+        // Indexed as an array: glm's operator[] is a switch, which GCC kept as branches.
+        static std::size_t row_offset(int axis) { return std::size_t(axis) * N * sizeof(Storage); }
+    };
+
+    // Watertight::intersect on every lane: the lanes hit in (t_min, t_max], with their t and
+    // barycentrics stored. Same operations, same order, so the same bits as the scalar test.
+    [[gnu::always_inline]] static std::uint32_t test(const Packet& packet, const LeafRay& ray, Storage t_min, Storage t_max,
                               Storage* t_out, Storage* b1_out, Storage* b2_out) {
-        const Watertight::Prepared<Storage>& ray = packed_ray.ray;
-        // Indexed as an array: glm's operator[] is a switch, which GCC kept as branches on the
-        // ray's axes in every leaf.
-        const Storage* origin = glm::value_ptr(ray.origin);
-        const auto relative = [&](int vertex, int axis) {
-            return Pack::load(packet.vertices[vertex][axis]) - Pack::broadcast(origin[axis]);
+        static_assert(std::is_standard_layout_v<Packet> && offsetof(Packet, vertices) == 0);
+        const auto* packet_bytes = reinterpret_cast<const unsigned char*>(&packet);
+        constexpr std::size_t vertex_stride = 3 * N * sizeof(Storage);
+        // Opaque in the loop: see simd/opaque.hpp.
+        const std::size_t row_x = simd::opaque(ray.row_x), row_y = simd::opaque(ray.row_y), row_z = simd::opaque(ray.row_z);
+        const auto row = [&](std::size_t axis_row, int vertex) {
+            return Pack::load(reinterpret_cast<const Storage*>(packet_bytes + axis_row + std::size_t(vertex) * vertex_stride));
         };
-        const Pack sx = Pack::broadcast(ray.sx), sy = Pack::broadcast(ray.sy), sz = Pack::broadcast(ray.sz);
-        const Pack a_z = relative(0, ray.kz), b_z = relative(1, ray.kz), c_z = relative(2, ray.kz);
-        const Pack ax = relative(0, ray.kx) - sx * a_z;
-        const Pack ay = relative(0, ray.ky) - sy * a_z;
-        const Pack bx = relative(1, ray.kx) - sx * b_z;
-        const Pack by = relative(1, ray.ky) - sy * b_z;
-        const Pack cx = relative(2, ray.kx) - sx * c_z;
-        const Pack cy = relative(2, ray.ky) - sy * c_z;
+        const Pack sx = ray.sx, sy = ray.sy, sz = ray.sz;
+        const Pack a_z = row(row_z, 0) - ray.origin_z, b_z = row(row_z, 1) - ray.origin_z, c_z = row(row_z, 2) - ray.origin_z;
+        const Pack ax = (row(row_x, 0) - ray.origin_x) - sx * a_z;
+        const Pack ay = (row(row_y, 0) - ray.origin_y) - sy * a_z;
+        const Pack bx = (row(row_x, 1) - ray.origin_x) - sx * b_z;
+        const Pack by = (row(row_y, 1) - ray.origin_y) - sy * b_z;
+        const Pack cx = (row(row_x, 2) - ray.origin_x) - sx * c_z;
+        const Pack cy = (row(row_y, 2) - ray.origin_y) - sy * c_z;
 
         Pack u = cx * by - cy * bx;
         Pack v = ax * cy - ay * cx;
