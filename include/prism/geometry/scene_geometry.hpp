@@ -457,7 +457,6 @@ private:
     }
 
 public:
-
     // The origin of a ray leaving `point` (from surface()) towards `direction`: the exact hit
     // point pushed past its error bound along the geometric normal, to the side the ray leaves
     // by, so the ray cannot find the surface it left again, at any scale and in float or double.

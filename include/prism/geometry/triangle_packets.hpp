@@ -41,7 +41,7 @@ public:
     using Pack = simd::Pack<Storage, N>;
 
     // What the packed test needs of a ray: the scalar test's own set-up, by reference; each
-    // use broadcasts it in the instruction (AVX-512's embedded broadcast, a load elsewhere).
+    // leaf call broadcasts it into packs once, before its packet loop (LeafRay).
     // Packs made once per ray cost six vector stores per ray and six lines the leaf then read;
     // a copy of the set-up was read back as one vector from the scalar stores that had just
     // made it, which no store forwards (70% of the copy's samples, 4% of a course profile).
@@ -173,8 +173,6 @@ private:
         return remaining >= std::uint32_t(N) ? (std::uint32_t(1) << N) - 1 : (std::uint32_t(1) << remaining) - 1;
     }
 
-    // Watertight::intersect on every lane: the lanes hit in (t_min, t_max], with their t and
-    // barycentrics stored. Same operations, same order, so the same bits as the scalar test.
     // The ray's set-up as a leaf's packet loop reads it, made once per leaf before the loop:
     // the origin's components and the shear broadcast, and each permuted axis's row as one byte
     // offset into a packet, its three vertices' rows at constant displacements from it. Indexed
