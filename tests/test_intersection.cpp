@@ -129,8 +129,9 @@ TEST_CASE_TEMPLATE("max_dimension picks the largest component", Real, float, dou
     CHECK(prism::max_dimension(glm::abs(V(0.5, -0.2, -4))) == 2);
 }
 
-// Watertight::Prepared picks its axes without branches; they and its shear must be those of the
-// paper's branching set-up, written out here, on ties, zeros, signed zeros and NaNs too.
+// Watertight::Prepared's axes and shear must be those of the paper's set-up, written out here,
+// on ties, zeros, signed zeros and NaNs too: a guard for any rewrite of it (a branch-free form
+// was tried and reverted, bench/RESULTS.md "kernel8" and the lead's section after it).
 TEST_CASE_TEMPLATE("Watertight::Prepared: the paper's axes and shear, ties, zeros and NaNs included", Real, float, double) {
     using V = prism::Vec3<Real>;
     std::vector<V> directions;

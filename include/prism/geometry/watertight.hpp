@@ -6,8 +6,6 @@
 
 #include <prism/geometry/triangle_hit.hpp>
 
-#include <glm/gtc/type_ptr.hpp>
-
 #include <cmath>
 #include <utility>
 
@@ -22,23 +20,13 @@ struct Watertight {
         int kx, ky, kz;      // axes permuted so that kz is the largest component of the direction
         Real sx, sy, sz;     // shear constants
 
-        // Without branches: the axes of a diffuse or reflected ray are as good as random, so
-        // the branches of max_dimension, of the sign and of glm's operator[] (a switch)
-        // mispredicted often; branch-free, the course's diffuse rays took 8-12% less time in
-        // prism_intersect_bench (bench/RESULTS.md, "kernel8").
-        // The axes are max_dimension's, ties and NaNs included, and the divisions the same.
         explicit Prepared(const Ray<Real>& ray) : origin(ray.origin) {
-            const Real* d = glm::value_ptr(ray.direction);
-            const Vec3<Real> magnitude = glm::abs(ray.direction);
-            const bool x_over_y = magnitude.x > magnitude.y;
-            const Real larger_of_xy = x_over_y ? magnitude.x : magnitude.y;
-            const int xy_wins = int(larger_of_xy > magnitude.z);
-            kz = 2 + xy_wins * (int(!x_over_y) - 2);  // as arithmetic: GCC compiled the ?: to a branch
-            // kx, ky = kz + 1, kz + 2 (mod 3), swapped where d[kz] < 0: swapping keeps the
-            // winding, and so the sign of the edge functions, consistent.
-            const int negative = int(d[kz] < 0);
-            kx = (kz + 1 + negative) % 3;
-            ky = (kz + 2 - negative) % 3;
+            const Vec3<Real>& d = ray.direction;
+            kz = max_dimension(glm::abs(d));
+            kx = kz == 2 ? 0 : kz + 1;
+            ky = kx == 2 ? 0 : kx + 1;
+            // Swapping keeps the winding, and so the sign of the edge functions, consistent.
+            if (d[kz] < 0) std::swap(kx, ky);
             sx = d[kx] / d[kz];
             sy = d[ky] / d[kz];
             sz = Real(1) / d[kz];
