@@ -1,9 +1,13 @@
 // simd/pack.hpp: max_keep and min_keep, whose exact IEEE behaviour the wide BVH's slab test relies on
-// (a NaN distance constrains nothing). A faster form must keep these bits.
+// (a NaN distance constrains nothing), and sqrt, negation and >=, which the direct spheres'
+// test on several rays relies on for the scalar sphere test's bits. A faster form must keep
+// these bits.
 #include <prism/simd/pack.hpp>
 
 #include <doctest/doctest.h>
 
+#include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 
@@ -41,7 +45,40 @@ void check_keep() {
     }
 }
 
+template <class T, int N>
+void check_sqrt_negation_compare() {
+    using Pack = prism::simd::Pack<T, N>;
+    const T nan = std::numeric_limits<T>::quiet_NaN(), inf = std::numeric_limits<T>::infinity();
+    const T values[] = {T(2),  T(0),   T(-0.0), inf, nan, T(-1), std::numeric_limits<T>::denorm_min(),
+                        T(3e-7), T(1e30), T(0.1), T(7), T(1) + std::numeric_limits<T>::epsilon()};
+    constexpr int count = sizeof(values) / sizeof(values[0]);
+    for (int start = 0; start < count; start += N) {
+        alignas(64) T a[N], b[N], root[N], negated[N];
+        for (int i = 0; i < N; ++i) {
+            a[i] = values[(start + i) % count];
+            b[i] = values[(start + 3 * i + 1) % count];
+        }
+        sqrt(Pack::load(a)).store(root);
+        (-Pack::load(a)).store(negated);
+        const std::uint32_t at_least = (Pack::load(a) >= Pack::load(b)).bits();
+        for (int i = 0; i < N; ++i) {
+            CAPTURE(a[i]);
+            CAPTURE(b[i]);
+            // The same bits, but for NaNs, whose payloads may differ.
+            if (std::isnan(std::sqrt(a[i]))) CHECK(std::isnan(root[i]));
+            else CHECK(same_bits(root[i], std::sqrt(a[i])));
+            CHECK(same_bits(negated[i], T(-a[i])));
+            CHECK(bool((at_least >> i) & 1) == (a[i] >= b[i]));
+        }
+    }
+}
+
 }  // namespace
+
+TEST_CASE_TEMPLATE("sqrt is std::sqrt's, -p and p >= q each lane's, to the bit", T, float, double) {
+    check_sqrt_negation_compare<T, 4>();
+    check_sqrt_negation_compare<T, 8>();
+}
 
 TEST_CASE_TEMPLATE("max_keep and min_keep are a > b ? a : b and a < b ? a : b, NaN and signed zeros included", T,
                    float, double) {

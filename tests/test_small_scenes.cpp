@@ -604,3 +604,100 @@ TEST_CASE_TEMPLATE("SceneGeometry: shadow rays tested several at a time get what
         CHECK(blocked < rays * 9 / 10);
     }
 }
+
+// Camera rays tested several at a time (SceneGeometry::intersect_each: the world meshes' leaves
+// and the direct spheres with a ray in each lane): every ray of a batch, of any length up to a
+// row's 16, gets the hit intersect gives it alone, to the bit (t, object, primitive,
+// barycentrics, the lowered t_max), under each culling rule, in the scenes above: direct
+// spheres of every map (plain, translated, ellipsoids), a floor of two triangles, merged flat
+// quads, a smooth tent, transformed plates and planes. The rays fan out from a camera, as a
+// row's do, aim through the spheres' surfaces (grazing ones included) and the quads' shared
+// diagonals, or go anywhere.
+TEST_CASE_TEMPLATE("SceneGeometry: camera rays tested several at a time get what each gets alone", Real, float, double) {
+    using Geometry = prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>;
+    using prism::BackfaceCulling;
+    for (int kind = 0; kind < 4; ++kind) {
+        CAPTURE(kind);
+        const scene::Scene world = kind == 3 ? tiny_meshes() : few_spheres(kind >= 1, kind == 2);
+        const Geometry geometry(world);
+        REQUIRE(geometry.intersection_batches());
+
+        std::mt19937 random(23);
+        std::uniform_real_distribution<double> uniform(-1, 1), fraction(0, 1);
+        const auto intersect = [&](BackfaceCulling culling, prism::Ray<Real>& ray, prism::Hit<Real>& hit) {
+            switch (culling) {
+                case BackfaceCulling::none: return geometry.template intersect<BackfaceCulling::none>(ray, hit);
+                case BackfaceCulling::flat_triangles: return geometry.template intersect<BackfaceCulling::flat_triangles>(ray, hit);
+                case BackfaceCulling::all: break;
+            }
+            return geometry.template intersect<BackfaceCulling::all>(ray, hit);
+        };
+        const auto intersect_each = [&](BackfaceCulling culling, prism::Ray<Real>* rays, prism::Hit<Real>* hits, int count) {
+            switch (culling) {
+                case BackfaceCulling::none: return geometry.template intersect_each<BackfaceCulling::none>(rays, hits, count);
+                case BackfaceCulling::flat_triangles:
+                    return geometry.template intersect_each<BackfaceCulling::flat_triangles>(rays, hits, count);
+                case BackfaceCulling::all: break;
+            }
+            return geometry.template intersect_each<BackfaceCulling::all>(rays, hits, count);
+        };
+        std::size_t rays_tested = 0, hits_found = 0;
+        std::array<std::size_t, 3> kinds_hit{};  // spheres, triangles, planes
+        for (int batch = 0; batch < 4000; ++batch) {
+            const BackfaceCulling culling = BackfaceCulling(batch % 3);
+            const int count = 1 + int(fraction(random) * 16);
+            const glm::dvec3 camera = glm::dvec3(0, 1, 9) + 2.0 * glm::dvec3(uniform(random), uniform(random), uniform(random));
+            std::array<prism::Ray<Real>, 16> rays;
+            for (int i = 0; i < count; ++i) {
+                glm::dvec3 origin = camera, direction;
+                if (batch % 4 == 0) {
+                    // A row's fan of directions toward the scene.
+                    direction = glm::normalize(glm::dvec3(-0.6 + 1.2 * (i + 0.5) / count, 0.3 * uniform(random) - 0.25, -1));
+                } else if (batch % 4 == 1) {
+                    const scene::Sphere& sphere = world.spheres[std::size_t(batch + i) % world.spheres.size()];
+                    const glm::dvec3 target = glm::dvec3(sphere.transform * glm::dvec4(sphere.center + sphere.radius * random_unit(random), 1.0));
+                    direction = glm::normalize(target - origin);
+                    if (i % 2 == 1) direction = glm::normalize(direction + 1e-4 * random_unit(random));
+                } else if (batch % 4 == 2) {
+                    // Through the floor's diagonal (x = z at height -1.5), where its two triangles meet.
+                    const double s = 3 * uniform(random);
+                    direction = glm::normalize(glm::dvec3(s, -1.5, s) - origin);
+                } else {
+                    origin = 5.0 * glm::dvec3(uniform(random), uniform(random), uniform(random));
+                    direction = random_unit(random);
+                }
+                rays[std::size_t(i)] = prism::Ray<Real>{prism::Vec3<Real>(origin), prism::Vec3<Real>(direction), Real(0), Real(60)};
+                if (batch % 5 == 0) rays[std::size_t(i)].t_max = Real(12 * fraction(random));
+                if (batch % 7 == 0) rays[std::size_t(i)].t_min = Real(1e-3);
+            }
+            std::array<prism::Ray<Real>, 16> each = rays;
+            std::array<prism::Hit<Real>, 16> hits, each_hits;
+            const std::uint32_t found = intersect_each(culling, each.data(), each_hits.data(), count);
+            for (int i = 0; i < count; ++i) {
+                CAPTURE(i);
+                const bool alone = intersect(culling, rays[std::size_t(i)], hits[std::size_t(i)]);
+                ++rays_tested;
+                REQUIRE(alone == bool((found >> i) & 1));
+                const prism::Hit<Real>& a = hits[std::size_t(i)];
+                const prism::Hit<Real>& b = each_hits[std::size_t(i)];
+                CHECK(same_bits(rays[std::size_t(i)].t_max, each[std::size_t(i)].t_max));
+                CHECK(same_bits(a.t, b.t));
+                CHECK(a.object == b.object);
+                CHECK(a.primitive == b.primitive);
+                CHECK(same_bits(a.b1, b.b1));
+                CHECK(same_bits(a.b2, b.b2));
+                if (!alone) continue;
+                ++hits_found;
+                const std::size_t kind_hit = a.object >= geometry.instance_count() ? 2 : a.object < world.meshes.size() + world.mesh_instances.size() ? 1 : 0;
+                ++kinds_hit[kind_hit];
+            }
+            CHECK(found < (std::uint32_t(1) << count));
+        }
+        // Hits and misses both common, and every kind of surface met.
+        CHECK(hits_found > rays_tested / 5);
+        CHECK(hits_found < rays_tested * 9 / 10);
+        CHECK(kinds_hit[0] > 100);
+        CHECK(kinds_hit[2] > 100);
+        if (kind >= 1) CHECK(kinds_hit[1] > 100);
+    }
+}

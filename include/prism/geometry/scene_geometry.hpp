@@ -312,6 +312,89 @@ public:
         return blocked;
     }
 
+    // Whether intersect_each tests its rays side by side: scenes without an index (direct_)
+    // whose world-space meshes, if any, are each one leaf, under the packed watertight test.
+    // The camera rays of hw1's small scenes (a floor of two triangles under spheres) are such
+    // rays; a root of two leaves keeps intersect's own tie rule (intersect_root_leaves).
+    bool intersection_batches() const {
+        if constexpr (Mesh::packed) {
+            if constexpr (Mesh::Packets::tests_ray_lanes) return direct_ && !two_leaves_;
+        }
+        return false;
+    }
+
+    // The closest hits of rays[0, count), each as intersect<Culling> gives it alone: its
+    // ray.t_max lowered to the hit and hits[i] filled, bit i of the answer set, where it hits
+    // (count <= 32). Under intersection_batches() the world meshes' leaves are tested against
+    // several rays at once (TriangleMesh::intersect_leaf_lanes, lane by lane the leaf test's
+    // bits), group after group as intersect takes them, then the direct spheres likewise
+    // (intersect_direct_spheres_lanes), each ray then the direct meshes and the planes on its
+    // own; elsewhere each ray is intersect's.
+    template <BackfaceCulling Culling>
+    std::uint32_t intersect_each(Ray<Real>* rays, Hit<Real>* hits, int count) const {
+        std::uint32_t found = 0;
+        if (!intersection_batches()) {
+            for (int i = 0; i < count; ++i)
+                if (intersect<Culling>(rays[i], hits[i])) found |= std::uint32_t(1) << i;
+            return found;
+        }
+        if constexpr (Mesh::packed) {
+            if constexpr (Mesh::Packets::tests_ray_lanes) {
+                using Packets = typename Mesh::Packets;
+                constexpr int width = Packets::ray_lanes;
+                for (int first = 0; first < count; first += width) {
+                    Ray<Real>* const group = rays + first;
+                    Hit<Real>* const group_hits = hits + first;
+                    const int n = std::min(width, count - first);
+                    const typename Packets::RayLanes lanes_ray(group, n);
+                    std::uint32_t world_hits = 0;
+                    for (const WorldMeshes& mesh_group : world_meshes_) {
+                        const typename Mesh::Leaf& leaf = mesh_group.leaves->leaf[0];
+                        std::uint32_t lanes = 0;
+                        for (int i = 0; i < n; ++i)
+                            if (!leaves_box(leaf.box, group[i])) lanes |= std::uint32_t(1) << i;
+                        if (lanes == 0) continue;
+                        alignas(64) Real limits[width];
+                        for (int i = 0; i < width; ++i) limits[i] = group[i < n ? i : 0].t_max;
+                        typename Packets::LaneHits lane_hits;
+                        lane_hits.t_max = Packets::LanePack::load(limits);
+                        const Mesh& index = index_of(mesh_group);
+                        if (culls_back_faces(Culling, mesh_group.smooth))
+                            index.template intersect_leaf_lanes<true>(lanes_ray, leaf, lanes, lane_hits);
+                        else
+                            index.template intersect_leaf_lanes<false>(lanes_ray, leaf, lanes, lane_hits);
+                        std::uint32_t taken = lane_hits.found & lanes;
+                        if (taken == 0) continue;
+                        alignas(64) Real t[width], b1[width], b2[width];
+                        lane_hits.t_max.store(t);
+                        lane_hits.b1.store(b1);
+                        lane_hits.b2.store(b2);
+                        for (; taken != 0; taken &= taken - 1) {
+                            const int i = std::countr_zero(taken);
+                            Hit<Real>& hit = group_hits[i];
+                            group[i].t_max = t[i];
+                            hit.t = t[i];
+                            hit.primitive = lane_hits.slot[std::size_t(i)];
+                            hit.b1 = b1[i];
+                            hit.b2 = b2[i];
+                            if (mesh_group.index) mesh_group.attribute(index.source_triangle(hit.primitive), hit);
+                            else hit.object = mesh_group.objects[0];
+                            world_hits |= std::uint32_t(1) << i;
+                        }
+                    }
+                    static_assert(width <= direct_width, "a group of rays fits the direct lanes");
+                    if (!direct_spheres_.empty()) intersect_direct_spheres_lanes(group, group_hits, n, world_hits);
+                    for (int i = 0; i < n; ++i) {
+                        const std::uint32_t mesh_lanes = direct_meshes_.empty() ? 0 : direct_lanes(group[i]).meshes;
+                        if (intersect_direct_meshes<Culling>(group[i], group_hits[i], mesh_lanes, (world_hits >> i) & 1))
+                            found |= std::uint32_t(1) << (first + i);
+                    }
+                }
+            }
+        }
+        return found;
+    }
+
     bool occluded_by_planes(const Ray<Real>& ray) const {
         for (const PlaneBlock& block : plane_blocks_) {
             alignas(64) Real t[direct_width];
@@ -893,8 +976,115 @@ private:
             hit.object = sphere.object;
             found = true;
         }
+        return intersect_direct_meshes<Culling>(ray, hit, may.meshes, found);
+    }
+
+    // The spheres of the direct top level against up to direct_width rays, one in each lane
+    // (intersect_each): sphere after sphere in intersect_direct's order, each lane's may_hit
+    // lane and SphereShape::intersect computed with their operations in their order, so each
+    // lane finds what intersect_direct's sphere loop finds for its ray (its t_max lowered, its
+    // hit's t, primitive and object set, its bit of `found` set). Spheres mapped by a matrix
+    // (ellipsoids) are tested ray by ray.
+    void intersect_direct_spheres_lanes(Ray<Real>* rays, Hit<Real>* hits, int count, std::uint32_t& found) const {
+        alignas(64) Real fields[8][direct_width];
+        for (int lane = 0; lane < direct_width; ++lane) {
+            const Ray<Real>& ray = rays[lane < count ? lane : 0];
+            for (int axis = 0; axis < 3; ++axis) {
+                fields[axis][lane] = ray.origin[axis];
+                fields[3 + axis][lane] = ray.direction[axis];
+            }
+            fields[6][lane] = ray.t_min;
+            fields[7][lane] = ray.t_max;
+        }
+        const DirectPack o[3] = {DirectPack::load(fields[0]), DirectPack::load(fields[1]), DirectPack::load(fields[2])};
+        const DirectPack d[3] = {DirectPack::load(fields[3]), DirectPack::load(fields[4]), DirectPack::load(fields[5])};
+        const DirectPack t_min = DirectPack::load(fields[6]);
+        DirectPack t_max = DirectPack::load(fields[7]);
+        const DirectPack zero = DirectPack::broadcast(0);
+        const auto dot = [](const DirectPack* x, const DirectPack* y) { return (x[0] * y[0] + x[1] * y[1]) + x[2] * y[2]; };
+        const DirectPack a = dot(d, d);  // glm::dot(direction, direction), as may_hit and the sphere test take it
+        const std::uint32_t rays_present = (std::uint32_t(1) << count) - 1;
+        const std::uint32_t starts_ahead = (t_min >= zero).bits();
+        const DirectPack slack = DirectPack::broadcast(16 * std::numeric_limits<Real>::epsilon());
+        for (std::size_t s = 0; s < direct_spheres_.size(); ++s) {
+            // may_hit's lane s, for every ray.
+            DirectPack to_bound[3];
+            for (int axis = 0; axis < 3; ++axis)
+                to_bound[axis] = o[axis] - DirectPack::broadcast(direct_bounds_.center[axis][s]);
+            const DirectPack along = dot(to_bound, d), distance_squared = dot(to_bound, to_bound);
+            const DirectPack radius_squared = DirectPack::broadcast(direct_bounds_.radius_squared[s]);
+            const std::uint32_t leaving = ((zero <= along) & (radius_squared < distance_squared)).bits() & starts_ahead;
+            const std::uint32_t near =
+                (a * distance_squared - along * along <= a * (radius_squared + slack * distance_squared)).bits();
+            std::uint32_t may = near & ~leaving & rays_present;
+            if (may == 0) continue;
+
+            const DirectSphere& sphere = direct_spheres_[s];
+            if (sphere.map == DirectSphere::Map::matrix) {
+                for (; may != 0; may &= may - 1) {
+                    const int i = std::countr_zero(may);
+                    Real t;
+                    if (!direct_hit(sphere, rays[i], rays[i].t_max, t)) continue;
+                    rays[i].t_max = t;
+                    hits[i].t = t;
+                    hits[i].primitive = 0;
+                    hits[i].object = sphere.object;
+                    found |= std::uint32_t(1) << i;
+                }
+                for (int i = 0; i < count; ++i) fields[7][i] = rays[i].t_max;
+                t_max = DirectPack::load(fields[7]);
+                continue;
+            }
+            // SphereShape::intersect, from the origin direct_hit gives it.
+            const SphereShape<Real>& shape = spheres_[instances_[sphere.object].shape];
+            DirectPack oc[3];
+            for (int axis = 0; axis < 3; ++axis) {
+                const DirectPack origin = sphere.map == DirectSphere::Map::translation
+                                              ? o[axis] + DirectPack::broadcast(sphere.translation[axis])
+                                              : o[axis];
+                oc[axis] = origin - DirectPack::broadcast(shape.center[axis]);
+            }
+            const DirectPack r2 = DirectPack::broadcast(shape.radius * shape.radius);
+            const DirectPack half_b = dot(oc, d);
+            const DirectPack c = dot(oc, oc) - r2;
+            may &= ~(((half_b >= zero) & (c > zero)).bits() & starts_ahead);
+            const DirectPack scale = half_b / a;
+            DirectPack perpendicular[3];
+            for (int axis = 0; axis < 3; ++axis) perpendicular[axis] = oc[axis] - scale * d[axis];
+            const DirectPack discriminant_over_a = r2 - dot(perpendicular, perpendicular);
+            may &= ~(discriminant_over_a < zero).bits();
+            if (may == 0) continue;
+            const DirectPack root = sqrt(a * discriminant_over_a);
+            const DirectPack q = select(half_b >= zero, -(half_b + root), -(half_b - root));
+            const auto q_zero = q == zero;
+            const DirectPack t0 = select(q_zero, zero, c / q), t1 = select(q_zero, zero, q / a);
+            const auto swap = t0 > t1;
+            const DirectPack nearer = select(swap, t1, t0), farther = select(swap, t0, t1);
+            const auto nearer_in = (nearer > t_min) & (nearer <= t_max);
+            const auto farther_in = (farther > t_min) & (farther <= t_max);
+            std::uint32_t taken = (nearer_in | farther_in).bits() & may;
+            if (taken == 0) continue;
+            const DirectPack t = select(nearer_in, nearer, farther);
+            alignas(64) Real t_lanes[direct_width];
+            t.store(t_lanes);
+            for (; taken != 0; taken &= taken - 1) {
+                const int i = std::countr_zero(taken);
+                rays[i].t_max = fields[7][i] = t_lanes[i];
+                hits[i].t = t_lanes[i];
+                hits[i].primitive = 0;
+                hits[i].object = sphere.object;
+                found |= std::uint32_t(1) << i;
+            }
+            t_max = DirectPack::load(fields[7]);
+        }
+    }
+
+    // intersect_direct past its spheres: the direct meshes of `mesh_lanes` (direct_lanes), then
+    // the planes; `found`: something nearer was hit.
+    template <BackfaceCulling Culling>
+    [[gnu::always_inline]] bool intersect_direct_meshes(Ray<Real>& ray, Hit<Real>& hit, std::uint32_t mesh_lanes, bool found) const {
         if constexpr (Mesh::packed) {
-            for (std::uint32_t lanes = may.meshes; lanes != 0; lanes &= lanes - 1) {
+            for (std::uint32_t lanes = mesh_lanes; lanes != 0; lanes &= lanes - 1) {
                 const DirectMesh& direct = direct_meshes_[std::size_t(std::countr_zero(lanes))];
                 const std::optional<Ray<Real>> local = direct_mesh_ray(direct, ray);
                 if (!local) continue;

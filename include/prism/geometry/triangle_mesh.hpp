@@ -166,6 +166,15 @@ public:
         return packets_.template intersect<CullBackfaces>(triangle_ray.packed_ray, ray.direction, leaf.first, leaf.count,
                                                           ray.t_min, t_max, hit);
     }
+    // The same leaf against several rays, one in each lane (TrianglePackets::intersect_lanes):
+    // each lane's hit is the one intersect_leaf gives its ray.
+    template <bool CullBackfaces, class RayLanes, class LaneHits>
+    [[gnu::always_inline]] void intersect_leaf_lanes(const RayLanes& rays, Leaf leaf, std::uint32_t lanes,
+                                                     LaneHits& hits) const
+        requires packed
+    {
+        packets_.template intersect_lanes<CullBackfaces>(rays, leaf.first, leaf.count, lanes, hits);
+    }
     [[gnu::always_inline]] bool occluded_leaf(const Ray<Real>& ray, const TriangleRay& triangle_ray, Leaf leaf, Real t_max) const
         requires packed
     {

@@ -124,6 +124,149 @@ public:
         return found;
     }
 
+    // The transposed test: several rays, one in each lane of a pack, against one triangle at a
+    // time (SceneGeometry::intersect_each: the camera rays of a row, whose closest hits among a
+    // small scene's few triangles had cost a camera ray more instructions than its shading).
+    // Each lane computes the scalar test's operations in the scalar test's order, on its own
+    // ray's permuted axes and shear, so its edge functions, t and barycentrics are the scalar
+    // test's bits; the slots are taken in order against each lane's shrinking t_max, as the
+    // leaf loop accepts them, so each lane ends with the hit intersect gives its ray alone.
+    // Only Watertight: DoubleRefine's rays carry a double refinement of their own.
+    static constexpr bool tests_ray_lanes = std::is_same_v<Intersector, Watertight>;
+    static constexpr int ray_lanes = 8;
+    using LanePack = simd::Pack<Storage, ray_lanes>;
+    using LaneMask = simd::Mask<Storage, ray_lanes>;
+
+    // The rays of the lanes, each lane's set-up as Watertight::Prepared makes it, transposed.
+    struct RayLanes {
+        LanePack origin_x, origin_y, origin_z;  // along each lane's kx, ky, kz
+        LanePack sx, sy, sz;
+        LanePack direction[3];  // the back-face test's direction, per world axis
+        LanePack t_min;
+        // Which world axis each lane's kx, ky and kz is: is 0, is 1 (else 2).
+        LaneMask x_is[2], y_is[2], z_is[2];
+
+        // From `count` (<= ray_lanes) rays; the lanes past them copy ray 0 and are left out
+        // by the caller's lane bits. Watertight::Prepared's set-up, lane by lane: the same
+        // comparisons choose the same axes (max_dimension's, then the swap), and the same
+        // divisions give the same shear, bit for bit. Made one ray at a time through
+        // Prepared, the set-up had cost as many instructions as the lanes' tests.
+        RayLanes(const Ray<Real>* rays, int count) {
+            alignas(64) Storage fields[7][ray_lanes];
+            for (int lane = 0; lane < ray_lanes; ++lane) {
+                const Ray<Real>& ray = rays[lane < count ? lane : 0];
+                for (int axis = 0; axis < 3; ++axis) {
+                    fields[axis][lane] = Storage(ray.origin[axis]);
+                    fields[3 + axis][lane] = Storage(ray.direction[axis]);
+                }
+                fields[6][lane] = Storage(ray.t_min);
+            }
+            const LanePack zero = LanePack::broadcast(0);
+            const LanePack origin[3] = {LanePack::load(fields[0]), LanePack::load(fields[1]), LanePack::load(fields[2])};
+            for (int axis = 0; axis < 3; ++axis) direction[axis] = LanePack::load(fields[3 + axis]);
+            t_min = LanePack::load(fields[6]);
+            LanePack magnitude[3];
+            for (int axis = 0; axis < 3; ++axis)
+                magnitude[axis] = select(direction[axis] < zero, -direction[axis], direction[axis]);
+            // kz = max_dimension(|d|): x > y ? (x > z ? 0 : 2) : (y > z ? 1 : 2).
+            const LaneMask x_over_y = magnitude[0] > magnitude[1];
+            const LaneMask z_0 = x_over_y & (magnitude[0] > magnitude[2]);
+            const LaneMask z_1 = (!x_over_y) & (magnitude[1] > magnitude[2]);
+            const LaneMask z_2 = !(z_0 | z_1);
+            // kx = kz + 1 and ky = kx + 1 (mod 3), swapped where d[kz] < 0.
+            const auto pick = [](const LaneMask& is_0, const LaneMask& is_1, const LanePack* v) {
+                return select(is_0, v[0], select(is_1, v[1], v[2]));
+            };
+            const LanePack d_z = pick(z_0, z_1, direction);
+            const LaneMask swap = d_z < zero;
+            const auto either = [&](const LaneMask& when_swapped, const LaneMask& otherwise) {
+                return (swap & when_swapped) | ((!swap) & otherwise);
+            };
+            z_is[0] = z_0;
+            z_is[1] = z_1;
+            // Unswapped, kx is 0 where kz is 2, 1 where kz is 0; ky is 0 where kz is 1, 1 where kz is 2.
+            x_is[0] = either(z_1, z_2);
+            x_is[1] = either(z_2, z_0);
+            y_is[0] = either(z_2, z_1);
+            y_is[1] = either(z_0, z_2);
+            origin_x = pick(x_is[0], x_is[1], origin);
+            origin_y = pick(y_is[0], y_is[1], origin);
+            origin_z = pick(z_is[0], z_is[1], origin);
+            sx = pick(x_is[0], x_is[1], direction) / d_z;
+            sy = pick(y_is[0], y_is[1], direction) / d_z;
+            sz = LanePack::broadcast(1) / d_z;
+        }
+    };
+
+    // Each lane's closest hit so far: t_max lowered by every hit, and the hit's slot and
+    // barycentrics; `found`, bit per lane.
+    struct LaneHits {
+        LanePack t_max = LanePack::broadcast(0);
+        LanePack b1 = LanePack::broadcast(0), b2 = LanePack::broadcast(0);
+        std::array<std::uint32_t, ray_lanes> slot{};
+        std::uint32_t found = 0;
+    };
+
+    // Closest hits among slots [first, first + count) for the lanes of `lanes`.
+    template <bool CullBackfaces>
+        requires tests_ray_lanes
+    [[gnu::always_inline]] void intersect_lanes(const RayLanes& rays, std::uint32_t first, std::uint32_t count,
+                                                std::uint32_t lanes, LaneHits& hits) const {
+        const LanePack zero = LanePack::broadcast(0);
+        for (std::uint32_t slot = first; slot < first + count; ++slot) {
+            const Packet& packet = packets_[slot / N];
+            const std::size_t lane_of_slot = slot % N;
+            // The slot's vertex `vertex` along each lane's permuted axis `is`.
+            const auto along = [&](int vertex, const LaneMask* is) {
+                const LanePack x = LanePack::broadcast(packet.vertices[vertex][0][lane_of_slot]);
+                const LanePack y = LanePack::broadcast(packet.vertices[vertex][1][lane_of_slot]);
+                const LanePack z = LanePack::broadcast(packet.vertices[vertex][2][lane_of_slot]);
+                return select(is[0], x, select(is[1], y, z));
+            };
+            const LanePack a_z = along(0, rays.z_is) - rays.origin_z, b_z = along(1, rays.z_is) - rays.origin_z,
+                           c_z = along(2, rays.z_is) - rays.origin_z;
+            const LanePack ax = (along(0, rays.x_is) - rays.origin_x) - rays.sx * a_z;
+            const LanePack ay = (along(0, rays.y_is) - rays.origin_y) - rays.sy * a_z;
+            const LanePack bx = (along(1, rays.x_is) - rays.origin_x) - rays.sx * b_z;
+            const LanePack by = (along(1, rays.y_is) - rays.origin_y) - rays.sy * b_z;
+            const LanePack cx = (along(2, rays.x_is) - rays.origin_x) - rays.sx * c_z;
+            const LanePack cy = (along(2, rays.y_is) - rays.origin_y) - rays.sy * c_z;
+
+            LanePack u = cx * by - cy * bx;
+            LanePack v = ax * cy - ay * cx;
+            LanePack w = bx * ay - by * ax;
+            if constexpr (std::is_same_v<Storage, float>) {
+                // The paper's fallback to double on an exactly zero edge function, lane by lane.
+                if (std::uint32_t zeros = ((u == zero) | (v == zero) | (w == zero)).bits() & lanes)
+                    edge_functions_in_double(zeros, ax, ay, bx, by, cx, cy, u, v, w);
+            }
+            const LaneMask outside = ((u < zero) | (v < zero) | (w < zero)) & ((u > zero) | (v > zero) | (w > zero));
+            const LanePack det = u + v + w;
+            LaneMask accepted = (!outside) & (det != zero);
+            if constexpr (CullBackfaces) {
+                // glm::dot's order: (x + y) + z of the products.
+                const Vec3<Real>& normal = normals_[slot];
+                const LanePack facing = (LanePack::broadcast(normal.x) * rays.direction[0] +
+                                         LanePack::broadcast(normal.y) * rays.direction[1]) +
+                                        LanePack::broadcast(normal.z) * rays.direction[2];
+                accepted = accepted & !(facing > zero);
+            }
+            if (!(accepted.bits() & lanes)) continue;
+            const LanePack az = rays.sz * a_z, bz = rays.sz * b_z, cz = rays.sz * c_z;
+            const LanePack t_scaled = u * az + v * bz + w * cz;
+            const LanePack inverse_det = LanePack::broadcast(1) / det;
+            const LanePack t = t_scaled * inverse_det;
+            accepted = accepted & (t > rays.t_min) & (t <= hits.t_max);
+            std::uint32_t taken = accepted.bits() & lanes;
+            if (taken == 0) continue;
+            hits.t_max = select(accepted, t, hits.t_max);
+            hits.b1 = select(accepted, v * inverse_det, hits.b1);
+            hits.b2 = select(accepted, w * inverse_det, hits.b2);
+            hits.found |= taken;
+            for (; taken != 0; taken &= taken - 1) hits.slot[std::size_t(std::countr_zero(taken))] = slot;
+        }
+    }
+
     // The source number of `slot`, as given to the constructor.
     std::uint32_t source(std::uint32_t slot) const
         requires keeps_sources
@@ -161,6 +304,26 @@ private:
     };
     using Packet = std::conditional_t<keeps_sources, PacketWithSources, PacketAlone>;
     static_assert(sizeof(Packet) == sizeof(PacketAlone), "the source numbers must fit the packet's padding");
+
+    // intersect_lanes' double fallback for the lanes of `zeros`: the scalar test's own.
+    [[gnu::noinline]] static void edge_functions_in_double(std::uint32_t zeros, const LanePack& ax, const LanePack& ay,
+                                                           const LanePack& bx, const LanePack& by, const LanePack& cx,
+                                                           const LanePack& cy, LanePack& u, LanePack& v, LanePack& w) {
+        alignas(64) Storage lanes[9][ray_lanes];
+        const LanePack* inputs[9] = {&ax, &ay, &bx, &by, &cx, &cy, &u, &v, &w};
+        for (int k = 0; k < 9; ++k) inputs[k]->store(lanes[k]);
+        for (; zeros != 0; zeros &= zeros - 1) {
+            const int i = std::countr_zero(zeros);
+            const double dax = lanes[0][i], day = lanes[1][i], dbx = lanes[2][i], dby = lanes[3][i], dcx = lanes[4][i],
+                         dcy = lanes[5][i];
+            lanes[6][i] = Storage(dcx * dby - dcy * dbx);
+            lanes[7][i] = Storage(dax * dcy - day * dcx);
+            lanes[8][i] = Storage(dbx * day - dby * dax);
+        }
+        u = LanePack::load(lanes[6]);
+        v = LanePack::load(lanes[7]);
+        w = LanePack::load(lanes[8]);
+    }
 
     static const Watertight::Prepared<Storage>& watertight_ray(const Prepared& prepared) {
         if constexpr (std::is_same_v<Intersector, DoubleRefine>)

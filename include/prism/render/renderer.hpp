@@ -138,6 +138,19 @@ private:
                 rays[std::size_t(i)] =
                     stored_whole(lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time));
             }
+            if constexpr (requires { integrator_.camera_hits(rays.data(), (Hit<Real>*)nullptr, n); }) {
+                if (integrator_.batches_camera_rays()) {
+                    std::array<Hit<Real>, batch> hits;
+                    const std::uint32_t found = integrator_.camera_hits(rays.data(), hits.data(), n);
+                    for (int i = 0; i < n; ++i) {
+                        const int x = start + i;
+                        typename Integrator::CameraPath path = camera_path(lens, camera, spread, streams[std::size_t(i)], x, y);
+                        image(x, y) = one_sample_pixel(integrator_.radiance_at(rays[std::size_t(i)], hits[std::size_t(i)],
+                                                                               (found >> i) & 1, path));
+                    }
+                    continue;
+                }
+            }
             for (int i = 0; i < n; ++i) {
                 const int x = start + i;
                 typename Integrator::CameraPath path = camera_path(lens, camera, spread, streams[std::size_t(i)], x, y);

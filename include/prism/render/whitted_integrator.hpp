@@ -140,6 +140,30 @@ public:
     // Radiance arriving along a camera ray with a unit direction.
     Vec3<Real> radiance(const Ray<Real>& ray, CameraPath& path) const { return trace(ray, 0, path, Real(0)); }
 
+    // Camera rays several at a time, where the geometry tests them side by side
+    // (SceneGeometry::intersection_batches): first their closest hits (camera_hits, the hits
+    // radiance's own intersection finds, each ray's t_max lowered as it lowers it), then each
+    // ray's radiance from its hit (radiance_at), the rest of radiance's work.
+    bool batches_camera_rays() const {
+        if constexpr (requires { geometry_.intersection_batches(); }) return geometry_.intersection_batches();
+        else return false;
+    }
+    std::uint32_t camera_hits(Ray<Real>* rays, Hit<Real>* hits, int count) const
+        requires requires(const Geometry& geometry) { geometry.template intersect_each<BackfaceCulling::none>(rays, hits, count); }
+    {
+        switch (settings_.backface_culling) {
+            case BackfaceCulling::none: break;
+            case BackfaceCulling::flat_triangles:
+                return geometry_.template intersect_each<BackfaceCulling::flat_triangles>(rays, hits, count);
+            case BackfaceCulling::all: return geometry_.template intersect_each<BackfaceCulling::all>(rays, hits, count);
+        }
+        return geometry_.template intersect_each<BackfaceCulling::none>(rays, hits, count);
+    }
+    Vec3<Real> radiance_at(const Ray<Real>& ray, const Hit<Real>& hit, bool found, CameraPath& path) const {
+        if (!found) return escaped(ray.direction, 0, path.pixel_uv);
+        return shade(ray, hit, 0, path, Real(0));
+    }
+
 private:
     // `travelled`: the distance from the camera to the ray's origin along the path, which widens
     // the ray cone like a pinhole's (mirrors are treated as flat: Ray Tracing Gems ch. 20's
@@ -147,7 +171,13 @@ private:
     Vec3<Real> trace(Ray<Real> ray, int depth, CameraPath& path, Real travelled) const {
         Hit<Real> hit;
         if (!intersect(ray, depth, hit)) return escaped(ray.direction, depth, path.pixel_uv);
+        return shade(ray, hit, depth, path, travelled);
+    }
 
+    // The radiance leaving the hit `hit` of `ray` back along it: trace's work past the
+    // intersection.
+    [[gnu::always_inline]] Vec3<Real> shade(const Ray<Real>& ray, const Hit<Real>& hit, int depth, CameraPath& path,
+                                            Real travelled) const {
         SurfacePoint<Real> point = shading_surface<textured<Textures, Real>>(geometry_, ray, hit, settings_.ray_offset);
         // Textures change a copy; without them the material is read where it is stored.
         std::conditional_t<textured<Textures, Real>, Material<Real>, const Material<Real>&> material =

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <type_traits>
 #include <utility>
@@ -65,9 +66,11 @@ struct Pack {
     PRISM_SIMD_INLINE friend Pack operator-(Pack a, Pack b) { return {a.native - b.native}; }
     PRISM_SIMD_INLINE friend Pack operator*(Pack a, Pack b) { return {a.native * b.native}; }
     PRISM_SIMD_INLINE friend Pack operator/(Pack a, Pack b) { return {a.native / b.native}; }
+    PRISM_SIMD_INLINE friend Pack operator-(Pack a) { return {-a.native}; }
     PRISM_SIMD_INLINE friend Mask<T, N> operator<(Pack a, Pack b) { return {a.native < b.native}; }
     PRISM_SIMD_INLINE friend Mask<T, N> operator<=(Pack a, Pack b) { return {a.native <= b.native}; }
     PRISM_SIMD_INLINE friend Mask<T, N> operator>(Pack a, Pack b) { return {a.native > b.native}; }
+    PRISM_SIMD_INLINE friend Mask<T, N> operator>=(Pack a, Pack b) { return {a.native >= b.native}; }
     PRISM_SIMD_INLINE friend Mask<T, N> operator==(Pack a, Pack b) { return {a.native == b.native}; }
     PRISM_SIMD_INLINE friend Mask<T, N> operator!=(Pack a, Pack b) { return {a.native != b.native}; }
     // mask ? a : b, lane by lane.
@@ -179,9 +182,14 @@ struct Pack {
     PRISM_SIMD_INLINE friend Pack operator-(Pack a, Pack b) { return map(a, b, [](T x, T y) { return x - y; }); }
     PRISM_SIMD_INLINE friend Pack operator*(Pack a, Pack b) { return map(a, b, [](T x, T y) { return x * y; }); }
     PRISM_SIMD_INLINE friend Pack operator/(Pack a, Pack b) { return map(a, b, [](T x, T y) { return x / y; }); }
+    PRISM_SIMD_INLINE friend Pack operator-(Pack a) {
+        for (T& lane : a.lanes) lane = -lane;
+        return a;
+    }
     PRISM_SIMD_INLINE friend Mask<T, N> operator<(Pack a, Pack b) { return compare(a, b, [](T x, T y) { return x < y; }); }
     PRISM_SIMD_INLINE friend Mask<T, N> operator<=(Pack a, Pack b) { return compare(a, b, [](T x, T y) { return x <= y; }); }
     PRISM_SIMD_INLINE friend Mask<T, N> operator>(Pack a, Pack b) { return compare(a, b, [](T x, T y) { return x > y; }); }
+    PRISM_SIMD_INLINE friend Mask<T, N> operator>=(Pack a, Pack b) { return compare(a, b, [](T x, T y) { return x >= y; }); }
     PRISM_SIMD_INLINE friend Mask<T, N> operator==(Pack a, Pack b) { return compare(a, b, [](T x, T y) { return x == y; }); }
     PRISM_SIMD_INLINE friend Mask<T, N> operator!=(Pack a, Pack b) { return compare(a, b, [](T x, T y) { return x != y; }); }
     PRISM_SIMD_INLINE friend Pack select(Mask<T, N> mask, Pack a, Pack b) {
@@ -226,6 +234,28 @@ PRISM_SIMD_INLINE inline Pack<T, N> min_keep(Pack<T, N> a, Pack<T, N> b) {
     else
 #endif
         return select(a < b, a, b);
+}
+
+// The correctly rounded square root, lane by lane: std::sqrt's bits. The 512-bit forms through
+// their masked intrinsics, as masked_max_ps above (GCC bug 105593).
+template <class T, int N>
+PRISM_SIMD_INLINE inline Pack<T, N> sqrt(Pack<T, N> a) {
+#if defined(PRISM_SIMD_STDX)
+    using Native = typename Pack<T, N>::Native;
+#if defined(PRISM_SIMD_X86) && defined(__AVX512F__)
+    if constexpr (std::is_same_v<T, float> && requires(const Native& v) { static_cast<__m512>(v); }) {
+        const __m512 x = static_cast<__m512>(a.native);
+        return {Native(_mm512_mask_sqrt_ps(x, __mmask16(-1), x))};
+    } else if constexpr (std::is_same_v<T, double> && requires(const Native& v) { static_cast<__m512d>(v); }) {
+        const __m512d x = static_cast<__m512d>(a.native);
+        return {Native(_mm512_mask_sqrt_pd(x, __mmask8(-1), x))};
+    } else
+#endif
+        return {stdx::sqrt(a.native)};
+#else
+    for (T& lane : a.lanes) lane = std::sqrt(lane);
+    return a;
+#endif
 }
 
 }  // namespace prism::simd
