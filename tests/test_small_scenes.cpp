@@ -550,7 +550,8 @@ TEST_CASE_TEMPLATE("SceneGeometry: a world-space index whose root has two leaves
 }
 
 // Shadow rays tested several at a time (SceneGeometry::occluded_each, a point's rays to its
-// lights): every ray of a batch, for any set of lanes, gets what occluded gives it alone, in the
+// lights; occluded_side_by_side, a ray in each lane): every ray of a batch, for any set of
+// lanes, gets what occluded gives it alone, in the
 // scenes above (direct spheres of each kind, planes, one-leaf world meshes, transformed
 // top-level plates), from points on and near the surfaces and in open space.
 TEST_CASE_TEMPLATE("SceneGeometry: shadow rays tested several at a time get what each gets alone", Real, float, double) {
@@ -597,6 +598,16 @@ TEST_CASE_TEMPLATE("SceneGeometry: shadow rays tested several at a time get what
                 ++rays;
             }
             CHECK(geometry.occluded_each(shadows.data(), lanes) == expected);
+            // The lit rays side by side (a row's shadow rays to one light): the same answers.
+            std::array<prism::Ray<Real>, 8> packed;
+            int packed_count = 0;
+            std::uint32_t packed_expected = 0;
+            for (std::uint32_t rest = lanes; rest != 0; rest &= rest - 1) {
+                const int lane = std::countr_zero(rest);
+                if ((expected >> lane) & 1) packed_expected |= std::uint32_t(1) << packed_count;
+                packed[std::size_t(packed_count++)] = shadows[std::size_t(lane)];
+            }
+            CHECK(geometry.occluded_side_by_side(packed.data(), packed_count) == packed_expected);
             blocked += std::size_t(std::popcount(expected));
         }
         // Both answers are common: the comparison is not of misses (or of hits) alone.
@@ -674,6 +685,11 @@ TEST_CASE_TEMPLATE("SceneGeometry: camera rays tested several at a time get what
                 if (batch % 7 == 0) rays[std::size_t(i)].t_min = Real(1e-3);
             }
             std::array<prism::Ray<Real>, 16> each = rays;
+            // The same rays as shadow rays, side by side (occluded_side_by_side).
+            std::uint32_t blocked = 0;
+            for (int i = 0; i < count; ++i)
+                if (geometry.occluded(rays[std::size_t(i)])) blocked |= std::uint32_t(1) << i;
+            CHECK(geometry.occluded_side_by_side(rays.data(), count) == blocked);
             std::array<prism::Hit<Real>, 16> hits, each_hits;
             const std::uint32_t found = intersect_each(culling, each.data(), each_hits.data(), count);
             for (int i = 0; i < count; ++i) {

@@ -397,6 +397,52 @@ public:
         return found;
     }
 
+    // Whether each of rays[0, count) is occluded (bit i for rays[i]; count <= 32), each as
+    // occluded answers it: under intersection_batches() the world meshes' leaves and the
+    // direct spheres with a ray in each lane (the shadow rays of a row's camera hits to one
+    // light), the planes ray by ray; elsewhere occluded itself.
+    std::uint32_t occluded_side_by_side(const Ray<Real>* rays, int count) const {
+        std::uint32_t blocked = 0;
+        if (!intersection_batches()) {
+            for (int i = 0; i < count; ++i)
+                if (occluded(rays[i])) blocked |= std::uint32_t(1) << i;
+            return blocked;
+        }
+        if constexpr (Mesh::packed) {
+            if constexpr (Mesh::Packets::tests_ray_lanes) {
+                using Packets = typename Mesh::Packets;
+                constexpr int width = Packets::ray_lanes;
+                for (int first = 0; first < count; first += width) {
+                    const Ray<Real>* const group = rays + first;
+                    const int n = std::min(width, count - first);
+                    const std::uint32_t present = (std::uint32_t(1) << n) - 1;
+                    std::uint32_t found = 0;
+                    std::optional<typename Packets::RayLanes> lanes_ray;
+                    std::optional<typename Packets::LanePack> t_max;
+                    for (const WorldMeshes& mesh_group : world_meshes_) {
+                        const typename Mesh::Leaf& leaf = mesh_group.leaves->leaf[0];
+                        std::uint32_t lanes = 0;
+                        for (int i = 0; i < n; ++i)
+                            if (!((found >> i) & 1) && !leaves_box(leaf.box, group[i])) lanes |= std::uint32_t(1) << i;
+                        if (lanes == 0) continue;
+                        if (!lanes_ray) {
+                            lanes_ray.emplace(group, n);
+                            alignas(64) Real limits[width];
+                            for (int i = 0; i < width; ++i) limits[i] = group[i < n ? i : 0].t_max;
+                            t_max = Packets::LanePack::load(limits);
+                        }
+                        found |= index_of(mesh_group).occluded_leaf_lanes(*lanes_ray, leaf, lanes, *t_max);
+                    }
+                    if (found != present && !direct_spheres_.empty())
+                        intersect_direct_spheres_lanes<true>(group, nullptr, n, found);
+                    for (int i = 0; i < n; ++i)  // no direct meshes (intersection_batches): the planes
+                        if (((found >> i) & 1) || occluded_by_planes(group[i])) blocked |= std::uint32_t(1) << (first + i);
+                }
+            }
+        }
+        return blocked;
+    }
+
     bool occluded_by_planes(const Ray<Real>& ray) const {
         for (const PlaneBlock& block : plane_blocks_) {
             alignas(64) Real t[direct_width];
@@ -986,8 +1032,11 @@ private:
     // lane and SphereShape::intersect computed with their operations in their order, so each
     // lane finds what intersect_direct's sphere loop finds for its ray (its t_max lowered, its
     // hit's t, primitive and object set, its bit of `found` set). Spheres mapped by a matrix
-    // (ellipsoids) are tested ray by ray.
-    void intersect_direct_spheres_lanes(Ray<Real>* rays, Hit<Real>* hits, int count, std::uint32_t& found) const {
+    // (ellipsoids) are tested ray by ray. AnyHit: occluded_direct's question instead, a hit
+    // below t_max (open) setting the lane's bit of `found`, and nothing else written.
+    template <bool AnyHit = false>
+    void intersect_direct_spheres_lanes(std::conditional_t<AnyHit, const Ray<Real>*, Ray<Real>*> rays, Hit<Real>* hits,
+                                        int count, std::uint32_t& found) const {
         alignas(64) Real fields[8][direct_width];
         for (int lane = 0; lane < direct_width; ++lane) {
             const Ray<Real>& ray = rays[lane < count ? lane : 0];
@@ -1019,6 +1068,7 @@ private:
             const std::uint32_t near =
                 (a * distance_squared - along * along <= a * (radius_squared + slack * distance_squared)).bits();
             std::uint32_t may = near & ~leaving & rays_present;
+            if constexpr (AnyHit) may &= ~found;
             if (may == 0) continue;
 
             const DirectSphere& sphere = direct_spheres_[s];
@@ -1027,14 +1077,21 @@ private:
                     const int i = std::countr_zero(may);
                     Real t;
                     if (!direct_hit(sphere, rays[i], rays[i].t_max, t)) continue;
-                    rays[i].t_max = t;
-                    hits[i].t = t;
-                    hits[i].primitive = 0;
-                    hits[i].object = sphere.object;
-                    found |= std::uint32_t(1) << i;
+                    if constexpr (AnyHit) {
+                        if (t < rays[i].t_max) found |= std::uint32_t(1) << i;
+                        continue;
+                    } else {
+                        rays[i].t_max = t;
+                        hits[i].t = t;
+                        hits[i].primitive = 0;
+                        hits[i].object = sphere.object;
+                        found |= std::uint32_t(1) << i;
+                    }
                 }
-                for (int i = 0; i < count; ++i) fields[7][i] = rays[i].t_max;
-                t_max = DirectPack::load(fields[7]);
+                if constexpr (!AnyHit) {
+                    for (int i = 0; i < count; ++i) fields[7][i] = rays[i].t_max;
+                    t_max = DirectPack::load(fields[7]);
+                }
                 continue;
             }
             // SphereShape::intersect, from the origin direct_hit gives it.
@@ -1064,20 +1121,24 @@ private:
             const DirectPack nearer = select(swap, t1, t0), farther = select(swap, t0, t1);
             const auto nearer_in = (nearer > t_min) & (nearer <= t_max);
             const auto farther_in = (farther > t_min) & (farther <= t_max);
-            std::uint32_t taken = (nearer_in | farther_in).bits() & may;
-            if (taken == 0) continue;
             const DirectPack t = select(nearer_in, nearer, farther);
-            alignas(64) Real t_lanes[direct_width];
-            t.store(t_lanes);
-            for (; taken != 0; taken &= taken - 1) {
-                const int i = std::countr_zero(taken);
-                rays[i].t_max = fields[7][i] = t_lanes[i];
-                hits[i].t = t_lanes[i];
-                hits[i].primitive = 0;
-                hits[i].object = sphere.object;
-                found |= std::uint32_t(1) << i;
+            if constexpr (AnyHit) {
+                found |= ((nearer_in | farther_in) & (t < t_max)).bits() & may;
+            } else {
+                std::uint32_t taken = (nearer_in | farther_in).bits() & may;
+                if (taken == 0) continue;
+                alignas(64) Real t_lanes[direct_width];
+                t.store(t_lanes);
+                for (; taken != 0; taken &= taken - 1) {
+                    const int i = std::countr_zero(taken);
+                    rays[i].t_max = fields[7][i] = t_lanes[i];
+                    hits[i].t = t_lanes[i];
+                    hits[i].primitive = 0;
+                    hits[i].object = sphere.object;
+                    found |= std::uint32_t(1) << i;
+                }
+                t_max = DirectPack::load(fields[7]);
             }
-            t_max = DirectPack::load(fields[7]);
         }
     }
 

@@ -175,6 +175,13 @@ public:
     {
         packets_.template intersect_lanes<CullBackfaces>(rays, leaf.first, leaf.count, lanes, hits);
     }
+    template <class RayLanes, class LanePack>
+    [[gnu::always_inline]] std::uint32_t occluded_leaf_lanes(const RayLanes& rays, Leaf leaf, std::uint32_t lanes,
+                                                             const LanePack& t_max) const
+        requires packed
+    {
+        return packets_.occluded_lanes(rays, leaf.first, leaf.count, lanes, t_max);
+    }
     [[gnu::always_inline]] bool occluded_leaf(const Ray<Real>& ray, const TriangleRay& triangle_ray, Leaf leaf, Real t_max) const
         requires packed
     {

@@ -212,59 +212,35 @@ public:
         requires tests_ray_lanes
     [[gnu::always_inline]] void intersect_lanes(const RayLanes& rays, std::uint32_t first, std::uint32_t count,
                                                 std::uint32_t lanes, LaneHits& hits) const {
-        const LanePack zero = LanePack::broadcast(0);
         for (std::uint32_t slot = first; slot < first + count; ++slot) {
-            const Packet& packet = packets_[slot / N];
-            const std::size_t lane_of_slot = slot % N;
-            // The slot's vertex `vertex` along each lane's permuted axis `is`.
-            const auto along = [&](int vertex, const LaneMask* is) {
-                const LanePack x = LanePack::broadcast(packet.vertices[vertex][0][lane_of_slot]);
-                const LanePack y = LanePack::broadcast(packet.vertices[vertex][1][lane_of_slot]);
-                const LanePack z = LanePack::broadcast(packet.vertices[vertex][2][lane_of_slot]);
-                return select(is[0], x, select(is[1], y, z));
-            };
-            const LanePack a_z = along(0, rays.z_is) - rays.origin_z, b_z = along(1, rays.z_is) - rays.origin_z,
-                           c_z = along(2, rays.z_is) - rays.origin_z;
-            const LanePack ax = (along(0, rays.x_is) - rays.origin_x) - rays.sx * a_z;
-            const LanePack ay = (along(0, rays.y_is) - rays.origin_y) - rays.sy * a_z;
-            const LanePack bx = (along(1, rays.x_is) - rays.origin_x) - rays.sx * b_z;
-            const LanePack by = (along(1, rays.y_is) - rays.origin_y) - rays.sy * b_z;
-            const LanePack cx = (along(2, rays.x_is) - rays.origin_x) - rays.sx * c_z;
-            const LanePack cy = (along(2, rays.y_is) - rays.origin_y) - rays.sy * c_z;
-
-            LanePack u = cx * by - cy * bx;
-            LanePack v = ax * cy - ay * cx;
-            LanePack w = bx * ay - by * ax;
-            if constexpr (std::is_same_v<Storage, float>) {
-                // The paper's fallback to double on an exactly zero edge function, lane by lane.
-                if (std::uint32_t zeros = ((u == zero) | (v == zero) | (w == zero)).bits() & lanes)
-                    edge_functions_in_double(zeros, ax, ay, bx, by, cx, cy, u, v, w);
-            }
-            const LaneMask outside = ((u < zero) | (v < zero) | (w < zero)) & ((u > zero) | (v > zero) | (w > zero));
-            const LanePack det = u + v + w;
-            LaneMask accepted = (!outside) & (det != zero);
-            if constexpr (CullBackfaces) {
-                // glm::dot's order: (x + y) + z of the products.
-                const Vec3<Real>& normal = normals_[slot];
-                const LanePack facing = (LanePack::broadcast(normal.x) * rays.direction[0] +
-                                         LanePack::broadcast(normal.y) * rays.direction[1]) +
-                                        LanePack::broadcast(normal.z) * rays.direction[2];
-                accepted = accepted & !(facing > zero);
-            }
-            if (!(accepted.bits() & lanes)) continue;
-            const LanePack az = rays.sz * a_z, bz = rays.sz * b_z, cz = rays.sz * c_z;
-            const LanePack t_scaled = u * az + v * bz + w * cz;
-            const LanePack inverse_det = LanePack::broadcast(1) / det;
-            const LanePack t = t_scaled * inverse_det;
-            accepted = accepted & (t > rays.t_min) & (t <= hits.t_max);
+            SlotLanes test;
+            if (!test_slot<CullBackfaces>(rays, slot, lanes, test)) continue;
+            const LaneMask accepted = test.accepted & (test.t > rays.t_min) & (test.t <= hits.t_max);
             std::uint32_t taken = accepted.bits() & lanes;
             if (taken == 0) continue;
-            hits.t_max = select(accepted, t, hits.t_max);
-            hits.b1 = select(accepted, v * inverse_det, hits.b1);
-            hits.b2 = select(accepted, w * inverse_det, hits.b2);
+            hits.t_max = select(accepted, test.t, hits.t_max);
+            hits.b1 = select(accepted, test.v * test.inverse_det, hits.b1);
+            hits.b2 = select(accepted, test.w * test.inverse_det, hits.b2);
             hits.found |= taken;
             for (; taken != 0; taken &= taken - 1) hits.slot[std::size_t(std::countr_zero(taken))] = slot;
         }
+    }
+
+    // The lanes of `lanes` that meet one of slots [first, first + count) in (t_min, t_max), each
+    // lane's answer the scalar `occluded`'s for its ray (open at t_max).
+    [[gnu::always_inline]] std::uint32_t occluded_lanes(const RayLanes& rays, std::uint32_t first, std::uint32_t count,
+                                                        std::uint32_t lanes, const LanePack& t_max) const
+        requires tests_ray_lanes
+    {
+        std::uint32_t blocked = 0;
+        for (std::uint32_t slot = first; slot < first + count && lanes != 0; ++slot) {
+            SlotLanes test;
+            if (!test_slot<false>(rays, slot, lanes, test)) continue;
+            const std::uint32_t hit = (test.accepted & (test.t > rays.t_min) & (test.t < t_max)).bits() & lanes;
+            blocked |= hit;
+            lanes &= ~hit;
+        }
+        return blocked;
     }
 
     // The source number of `slot`, as given to the constructor.
@@ -304,6 +280,63 @@ private:
     };
     using Packet = std::conditional_t<keeps_sources, PacketWithSources, PacketAlone>;
     static_assert(sizeof(Packet) == sizeof(PacketAlone), "the source numbers must fit the packet's padding");
+
+    // One slot against the lanes (intersect_lanes, occluded_lanes): the lanes the watertight
+    // test accepts before its interval check, their t, v, w and 1 / det.
+    struct SlotLanes {
+        LaneMask accepted;
+        LanePack t, v, w, inverse_det;
+    };
+    // False where no lane of `lanes` is accepted (t left uncomputed).
+    template <bool CullBackfaces>
+    [[gnu::always_inline]] bool test_slot(const RayLanes& rays, std::uint32_t slot, std::uint32_t lanes, SlotLanes& out) const {
+        const LanePack zero = LanePack::broadcast(0);
+        const Packet& packet = packets_[slot / N];
+        const std::size_t lane_of_slot = slot % N;
+        // The slot's vertex `vertex` along each lane's permuted axis `is`.
+        const auto along = [&](int vertex, const LaneMask* is) {
+            const LanePack x = LanePack::broadcast(packet.vertices[vertex][0][lane_of_slot]);
+            const LanePack y = LanePack::broadcast(packet.vertices[vertex][1][lane_of_slot]);
+            const LanePack z = LanePack::broadcast(packet.vertices[vertex][2][lane_of_slot]);
+            return select(is[0], x, select(is[1], y, z));
+        };
+        const LanePack a_z = along(0, rays.z_is) - rays.origin_z, b_z = along(1, rays.z_is) - rays.origin_z,
+                       c_z = along(2, rays.z_is) - rays.origin_z;
+        const LanePack ax = (along(0, rays.x_is) - rays.origin_x) - rays.sx * a_z;
+        const LanePack ay = (along(0, rays.y_is) - rays.origin_y) - rays.sy * a_z;
+        const LanePack bx = (along(1, rays.x_is) - rays.origin_x) - rays.sx * b_z;
+        const LanePack by = (along(1, rays.y_is) - rays.origin_y) - rays.sy * b_z;
+        const LanePack cx = (along(2, rays.x_is) - rays.origin_x) - rays.sx * c_z;
+        const LanePack cy = (along(2, rays.y_is) - rays.origin_y) - rays.sy * c_z;
+
+        LanePack u = cx * by - cy * bx;
+        out.v = ax * cy - ay * cx;
+        out.w = bx * ay - by * ax;
+        if constexpr (std::is_same_v<Storage, float>) {
+            // The paper's fallback to double on an exactly zero edge function, lane by lane.
+            if (std::uint32_t zeros = ((u == zero) | (out.v == zero) | (out.w == zero)).bits() & lanes)
+                edge_functions_in_double(zeros, ax, ay, bx, by, cx, cy, u, out.v, out.w);
+        }
+        const LanePack& v = out.v;
+        const LanePack& w = out.w;
+        const LaneMask outside = ((u < zero) | (v < zero) | (w < zero)) & ((u > zero) | (v > zero) | (w > zero));
+        const LanePack det = u + v + w;
+        out.accepted = (!outside) & (det != zero);
+        if constexpr (CullBackfaces) {
+            // glm::dot's order: (x + y) + z of the products.
+            const Vec3<Real>& normal = normals_[slot];
+            const LanePack facing = (LanePack::broadcast(normal.x) * rays.direction[0] +
+                                     LanePack::broadcast(normal.y) * rays.direction[1]) +
+                                    LanePack::broadcast(normal.z) * rays.direction[2];
+            out.accepted = out.accepted & !(facing > zero);
+        }
+        if (!(out.accepted.bits() & lanes)) return false;
+        const LanePack az = rays.sz * a_z, bz = rays.sz * b_z, cz = rays.sz * c_z;
+        const LanePack t_scaled = u * az + v * bz + w * cz;
+        out.inverse_det = LanePack::broadcast(1) / det;
+        out.t = t_scaled * out.inverse_det;
+        return true;
+    }
 
     // intersect_lanes' double fallback for the lanes of `zeros`: the scalar test's own.
     [[gnu::noinline]] static void edge_functions_in_double(std::uint32_t zeros, const LanePack& ax, const LanePack& ay,

@@ -142,6 +142,18 @@ private:
                 if (integrator_.batches_camera_rays()) {
                     std::array<Hit<Real>, batch> hits;
                     const std::uint32_t found = integrator_.camera_hits(rays.data(), hits.data(), n);
+                    const auto make_path = [&](int i) {
+                        return camera_path(lens, camera, spread, streams[std::size_t(i)], start + i, y);
+                    };
+                    if constexpr (requires(std::array<Vec3<Real>, batch> radiance) {
+                                      integrator_.radiance_row(rays.data(), hits.data(), found, n, make_path, radiance.data());
+                                  }) {
+                        static_assert(Integrator::row_width >= batch);
+                        std::array<Vec3<Real>, batch> radiance;
+                        integrator_.radiance_row(rays.data(), hits.data(), found, n, make_path, radiance.data());
+                        for (int i = 0; i < n; ++i) image(start + i, y) = one_sample_pixel(radiance[std::size_t(i)]);
+                        continue;
+                    }
                     for (int i = 0; i < n; ++i) {
                         const int x = start + i;
                         typename Integrator::CameraPath path = camera_path(lens, camera, spread, streams[std::size_t(i)], x, y);

@@ -14,6 +14,7 @@
 #include <prism/light/point_light.hpp>
 #include <prism/material/fresnel.hpp>
 #include <prism/material/material.hpp>
+#include <prism/memory/unconstructed.hpp>
 #include <prism/render/integrator.hpp>
 #include <prism/render/stored_whole.hpp>
 #include <prism/sampling/random.hpp>
@@ -24,7 +25,6 @@
 #include <bit>
 #include <cstdint>
 #include <cmath>
-#include <new>
 #include <optional>
 #include <type_traits>
 #include <vector>
@@ -123,6 +123,16 @@ Vec3<Real> perturb(const Vec3<Real>& direction, Real roughness, const Vec2<Real>
 template <Scalar Real, class Geometry, class LightSetT, class Textures = NoTextures<Real>,
           class Environment = NoEnvironment<Real>>
 class WhittedIntegrator {
+    // The error-bounded origins of the rays leaving one surface point, one per side they leave
+    // by (SceneGeometry::spawn_side), each computed for the first ray that needs it: the shadow
+    // rays to every light and the reflected and refracted rays share them. A mirror's reflected
+    // ray leaves by the side its lit shadow rays left by, so it no longer computes the origin
+    // again (offset_ray_origin was 3.7% of hw1 simple_reflectance's samples).
+    struct SpawnOrigins {
+        std::array<Vec3<Real>, 4> origin;
+        unsigned known = 0;
+    };
+
 public:
     WhittedIntegrator(const Geometry& geometry, const LightSetT& lights, const std::vector<Material<Real>>& materials,
                       const Textures& textures, const Environment& environment, const Vec3<Real>& ambient_light,
@@ -165,6 +175,116 @@ public:
         return shade(ray, hit, 0, path, Real(0));
     }
 
+    // radiance_at for a row's camera rays together (count <= row_width), in point-lit
+    // renderers without textures: every hit's shadow rays are made first, then each light's
+    // are tested side by side across the row (SceneGeometry::occluded_side_by_side: a ray in
+    // each SIMD lane), then each point is shaded and its reflections traced. The same draws,
+    // rays, tests and sums as radiance_at, so the same bits. `make_path(i)`: ray i's
+    // CameraPath (its pixel's stream, by reference).
+    static constexpr int row_width = 16;
+    static constexpr std::size_t row_lights = 8;
+    template <class MakePath>
+        requires(!textured<Textures, Real> && std::is_same_v<LightSetT, LightSet<Real, PointLight>> &&
+                 requires(const Geometry& geometry, const Ray<Real>* rays) { geometry.occluded_side_by_side(rays, 1); })
+    void radiance_row(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count, MakePath make_path,
+                      Vec3<Real>* radiance) const {
+        const std::vector<PointLight<Real>>& lights = *lights_.template of_type<PointLight>();
+        if (lights.size() > row_lights) {
+            for (int i = 0; i < count; ++i) {
+                CameraPath path = make_path(i);
+                radiance[i] = radiance_at(rays[i], hits[i], (found >> i) & 1, path);
+            }
+            return;
+        }
+        // What shade knows of a point before its direct lighting (the point made in place, the
+        // rest of the record after it: value-initialised whole, the record had cost 5% of
+        // simple_shading's instructions), and per light what that lighting draws.
+        struct RowPoint {
+            SurfacePoint<Real> point;
+            Vec3<Real> normal, color;
+            SpawnOrigins origins;
+            std::uint32_t lit;  // bit k: light k's shadow ray is made
+            bool front_face, inside_medium;
+        };
+        Unconstructed<RowPoint, row_width> points;
+        std::array<std::array<Vec3<Real>, row_width>, row_lights> directions, radiances;
+        std::array<std::array<Real, row_width>, row_lights> cosines;
+        std::array<Unconstructed<Ray<Real>, row_width>, row_lights> shadows;  // per light, per ray
+        for (int i = 0; i < count; ++i) {
+            CameraPath path = make_path(i);
+            if (!((found >> i) & 1)) {
+                radiance[i] = escaped(rays[i].direction, 0, path.pixel_uv);
+                continue;
+            }
+            const Ray<Real>& ray = rays[i];
+            RowPoint& at = points.make_from(std::size_t(i), [&] {
+                return RowPoint{shading_surface<false>(geometry_, ray, hits[i], settings_.ray_offset)};
+            });
+            const Material<Real>& material = materials_[at.point.material];
+            at.front_face = glm::dot(at.point.geometric_normal, ray.direction) < 0;
+            at.normal = at.front_face ? at.point.shading_normal : -at.point.shading_normal;
+            at.inside_medium = !at.front_face && material.type == scene::MaterialType::dielectric;
+            if (at.inside_medium) continue;
+            at.color = geometry_.emitted(hits[i].object) + material.ambient * ambient_light_;
+            // direct_lighting's samples and shadow rays (point_lighting_batched's, light by light).
+            const Vec3<Real>& position = at.point.position;
+            const ShadingFrame<Real> frame{position, at.normal};
+            for (std::size_t k = 0; k < lights.size(); ++k) {
+                path.random.template skip<Real>(2);
+                const LightSample<Real> sample = lights[k].sample(frame);
+                directions[k][std::size_t(i)] = sample.direction;
+                radiances[k][std::size_t(i)] = sample.radiance;
+                cosines[k][std::size_t(i)] = glm::dot(at.normal, sample.direction);
+                if (cosines[k][std::size_t(i)] <= 0) continue;
+                const Ray<Real> shadow = leaving(at.point, at.normal, sample.direction, at.point.time, at.origins);
+                Ray<Real>& made = shadows[k].make(std::size_t(i));
+                made.origin = shadow.origin;
+                made.direction = std::isinf(sample.distance)
+                                     ? shadow.direction
+                                     : unit_vector(position + sample.direction * sample.distance - shadow.origin);
+                made.t_min = shadow.t_min;
+                made.t_max = sample.distance;
+                made.time = shadow.time;
+                at.lit |= std::uint32_t(1) << k;
+            }
+        }
+        // Each light's shadow rays across the row, side by side.
+        std::array<std::uint32_t, row_width> blocked{};
+        for (std::size_t k = 0; k < lights.size(); ++k) {
+            Unconstructed<Ray<Real>, row_width> packed;
+            std::array<int, row_width> owner;
+            int n = 0;
+            for (int i = 0; i < count; ++i) {
+                if (!((found >> i) & 1) || !((points[std::size_t(i)].lit >> k) & 1)) continue;
+                packed.make(std::size_t(n), shadows[k][std::size_t(i)]);
+                owner[std::size_t(n++)] = i;
+            }
+            if (n == 0) continue;
+            for (std::uint32_t hit = geometry_.occluded_side_by_side(packed.data(), n); hit != 0; hit &= hit - 1)
+                blocked[std::size_t(owner[std::size_t(std::countr_zero(hit))])] |= std::uint32_t(1) << k;
+        }
+        for (int i = 0; i < count; ++i) {
+            if (!((found >> i) & 1)) continue;
+            RowPoint& at = points[std::size_t(i)];
+            const Material<Real>& material = materials_[at.point.material];
+            if (!at.inside_medium) {
+                Vec3<Real> direct(0);
+                const Vec3<Real> to_viewer = -rays[i].direction;
+                for (std::uint32_t lit = at.lit & ~blocked[std::size_t(i)]; lit != 0; lit &= lit - 1) {
+                    const std::size_t k = std::size_t(std::countr_zero(lit));
+                    LightSample<Real> sample;
+                    sample.direction = directions[k][std::size_t(i)];
+                    sample.radiance = radiances[k][std::size_t(i)];
+                    direct += reflected(material, at.normal, to_viewer, sample, cosines[k][std::size_t(i)]);
+                }
+                at.color += direct;
+            }
+            CameraPath path = make_path(i);
+            radiance[i] = reflect_and_absorb(rays[i], hits[i], at.point, material, at.normal, at.front_face,
+                                             at.inside_medium, at.color, 0, path, Real(0) + hits[i].t, at.origins);
+        }
+    }
+
 private:
     // `travelled`: the distance from the camera to the ray's origin along the path, which widens
     // the ray cone like a pinhole's (mirrors are treated as flat: Ray Tracing Gems ch. 20's
@@ -204,6 +324,19 @@ private:
             color += direct_lighting(point, normal, -d, material, random, origins);
         }
 
+        return reflect_and_absorb(ray, hit, point, material, normal, front_face, inside_medium, color, depth, path,
+                                  travelled, origins);
+    }
+
+    // shade's work past the direct lighting: the reflected (and refracted) rays traced, and
+    // Beer's law inside a medium; `color` is the point's own (emitted, ambient, direct).
+    [[gnu::always_inline]] Vec3<Real> reflect_and_absorb(const Ray<Real>& ray, const Hit<Real>& hit,
+                                                         const SurfacePoint<Real>& point, const Material<Real>& material,
+                                                         const Vec3<Real>& normal, bool front_face, bool inside_medium,
+                                                         Vec3<Real> color, int depth, CameraPath& path, Real travelled,
+                                                         SpawnOrigins& origins) const {
+        Random& random = path.random;
+        const Vec3<Real>& d = ray.direction;
         // Blinn-Phong surfaces spawn no rays; the others reflect (and dielectrics refract).
         if (depth < settings_.max_recursion_depth && material.type != scene::MaterialType::blinn_phong) {
             using scene::MaterialType;
@@ -252,15 +385,6 @@ private:
         return depth == 0 ? background_ : Vec3<Real>(0);
     }
 
-    // The error-bounded origins of the rays leaving one surface point, one per side they leave
-    // by (SceneGeometry::spawn_side), each computed for the first ray that needs it: the shadow
-    // rays to every light and the reflected and refracted rays share them. A mirror's reflected
-    // ray leaves by the side its lit shadow rays left by, so it no longer computes the origin
-    // again (offset_ray_origin was 3.7% of hw1 simple_reflectance's samples).
-    struct SpawnOrigins {
-        std::array<Vec3<Real>, 4> origin;
-        unsigned known = 0;
-    };
 
     // The ray leaving `point` along `direction`, as leaving_ray gives it, from the origin
     // `origins` holds for its side where rays leave by the error bound. spawn_origin depends on
@@ -352,14 +476,8 @@ private:
             // simple_reflectance's samples of this function).
             std::array<Vec3<Real>, batch> directions, radiances;
             std::array<Real, batch> cosines;
-            // Left unconstructed but for the lit lanes, each made below before occluded_each
-            // reads it: eight rays value-initialised had cost 56 instructions a shading point
-            // (2% of hw1 simple_reflectance's).
-            union ShadowRays {
-                ShadowRays() {}
-                Ray<Real> ray[batch];
-            } shadow_rays;
-            Ray<Real>* const shadows = shadow_rays.ray;
+            // Made for the lit lanes alone, the ones occluded_each reads (memory/unconstructed.hpp).
+            Unconstructed<Ray<Real>, batch> shadows;
             std::uint32_t lit = 0;
             for (std::size_t i = 0; i < count; ++i) {
                 random.template skip<Real>(2);
@@ -369,7 +487,7 @@ private:
                 cosines[i] = glm::dot(normal, sample.direction);
                 if (cosines[i] <= 0) continue;
                 const Ray<Real> shadow = leaving(point, normal, sample.direction, point.time, origins);
-                new (&shadows[i]) Ray<Real>;
+                shadows.make(i);
                 shadows[i].origin = shadow.origin;
                 shadows[i].direction = std::isinf(sample.distance)
                                            ? shadow.direction
@@ -379,7 +497,7 @@ private:
                 shadows[i].time = shadow.time;
                 lit |= std::uint32_t(1) << i;
             }
-            lit &= ~geometry_.occluded_each(shadows, lit);
+            lit &= ~geometry_.occluded_each(shadows.data(), lit);
             for (; lit != 0; lit &= lit - 1) {
                 const std::size_t i = std::size_t(std::countr_zero(lit));
                 LightSample<Real> sample;
