@@ -353,15 +353,11 @@ public:
                     std::uint32_t world_hits = 0;
                     for (const WorldMeshes& mesh_group : world_meshes_) {
                         const typename Mesh::Leaf& leaf = mesh_group.leaves->leaf[0];
-                        std::uint32_t lanes = 0;
-                        for (int i = 0; i < n; ++i)
-                            if (!leaves_box(leaf.box, group[i])) lanes |= std::uint32_t(1) << i;
+                        const std::uint32_t lanes = lanes_reaching(leaf, group, n, 0);
                         if (lanes == 0) continue;
                         if (!lanes_ray) lanes_ray.emplace(group, n);
-                        alignas(64) Real limits[width];
-                        for (int i = 0; i < width; ++i) limits[i] = group[i < n ? i : 0].t_max;
                         typename Packets::LaneHits lane_hits;
-                        lane_hits.t_max = Packets::LanePack::load(limits);
+                        lane_hits.t_max = lanes_t_max<Packets>(group, n);
                         const Mesh& index = index_of(mesh_group);
                         if (culls_back_faces(Culling, mesh_group.smooth))
                             index.template intersect_leaf_lanes<true>(*lanes_ray, leaf, lanes, lane_hits);
@@ -421,15 +417,11 @@ public:
                     std::optional<typename Packets::LanePack> t_max;
                     for (const WorldMeshes& mesh_group : world_meshes_) {
                         const typename Mesh::Leaf& leaf = mesh_group.leaves->leaf[0];
-                        std::uint32_t lanes = 0;
-                        for (int i = 0; i < n; ++i)
-                            if (!((found >> i) & 1) && !leaves_box(leaf.box, group[i])) lanes |= std::uint32_t(1) << i;
+                        const std::uint32_t lanes = lanes_reaching(leaf, group, n, found);
                         if (lanes == 0) continue;
                         if (!lanes_ray) {
                             lanes_ray.emplace(group, n);
-                            alignas(64) Real limits[width];
-                            for (int i = 0; i < width; ++i) limits[i] = group[i < n ? i : 0].t_max;
-                            t_max = Packets::LanePack::load(limits);
+                            t_max = lanes_t_max<Packets>(group, n);
                         }
                         found |= index_of(mesh_group).occluded_leaf_lanes(*lanes_ray, leaf, lanes, *t_max);
                     }
@@ -1140,6 +1132,23 @@ private:
                 t_max = DirectPack::load(fields[7]);
             }
         }
+    }
+
+    // The lanes of rays[0, n), less those of `skip`, whose ray may reach `leaf`: intersect's
+    // and occluded's own leaves_box test, ray by ray.
+    [[gnu::always_inline]] static std::uint32_t lanes_reaching(const typename Mesh::Leaf& leaf, const Ray<Real>* rays, int n,
+                                                               std::uint32_t skip) {
+        std::uint32_t lanes = 0;
+        for (int i = 0; i < n; ++i)
+            if (!((skip >> i) & 1) && !leaves_box(leaf.box, rays[i])) lanes |= std::uint32_t(1) << i;
+        return lanes;
+    }
+    // The rays' t_max, a lane each (the lanes past n copy ray 0's, as RayLanes does).
+    template <class Packets>
+    [[gnu::always_inline]] static typename Packets::LanePack lanes_t_max(const Ray<Real>* rays, int n) {
+        alignas(64) Real limits[Packets::ray_lanes];
+        for (int i = 0; i < Packets::ray_lanes; ++i) limits[i] = rays[i < n ? i : 0].t_max;
+        return Packets::LanePack::load(limits);
     }
 
     // intersect_direct past its spheres: the direct meshes of `mesh_lanes` (direct_lanes), then

@@ -236,15 +236,7 @@ public:
                 radiances[k][std::size_t(i)] = sample.radiance;
                 cosines[k][std::size_t(i)] = glm::dot(at.normal, sample.direction);
                 if (cosines[k][std::size_t(i)] <= 0) continue;
-                const Ray<Real> shadow = leaving(at.point, at.normal, sample.direction, at.point.time, at.origins);
-                Ray<Real>& made = shadows[k].make(std::size_t(i));
-                made.origin = shadow.origin;
-                made.direction = std::isinf(sample.distance)
-                                     ? shadow.direction
-                                     : unit_vector(position + sample.direction * sample.distance - shadow.origin);
-                made.t_min = shadow.t_min;
-                made.t_max = sample.distance;
-                made.time = shadow.time;
+                make_shadow_ray(shadows[k].make(std::size_t(i)), at.point, at.normal, sample, at.origins);
                 at.lit |= std::uint32_t(1) << k;
             }
         }
@@ -486,15 +478,7 @@ private:
                 radiances[i] = sample.radiance;
                 cosines[i] = glm::dot(normal, sample.direction);
                 if (cosines[i] <= 0) continue;
-                const Ray<Real> shadow = leaving(point, normal, sample.direction, point.time, origins);
-                shadows.make(i);
-                shadows[i].origin = shadow.origin;
-                shadows[i].direction = std::isinf(sample.distance)
-                                           ? shadow.direction
-                                           : unit_vector(position + sample.direction * sample.distance - shadow.origin);
-                shadows[i].t_min = shadow.t_min;
-                shadows[i].t_max = sample.distance;
-                shadows[i].time = shadow.time;
+                make_shadow_ray(shadows.make(i), point, normal, sample, origins);
                 lit |= std::uint32_t(1) << i;
             }
             lit &= ~geometry_.occluded_each(shadows.data(), lit);
@@ -507,6 +491,23 @@ private:
             }
         }
         return color;
+    }
+
+    // A point light's shadow ray from `point` into `made`, as direct_lighting's loop makes it:
+    // from the offset origin, aimed at the light from there, up to the light's distance.
+    // Field by field: a whole Ray copied into the batches' arrays was read back wider than its
+    // parts had been written (a failed store forward, a fifth of hw1 simple_reflectance's
+    // samples of point_lighting_batched).
+    [[gnu::always_inline]] void make_shadow_ray(Ray<Real>& made, const SurfacePoint<Real>& point, const Vec3<Real>& normal,
+                                                const LightSample<Real>& sample, SpawnOrigins& origins) const {
+        const Ray<Real> shadow = leaving(point, normal, sample.direction, point.time, origins);
+        made.origin = shadow.origin;
+        made.direction = std::isinf(sample.distance)
+                             ? shadow.direction
+                             : unit_vector(point.position + sample.direction * sample.distance - shadow.origin);
+        made.t_min = shadow.t_min;
+        made.t_max = sample.distance;
+        made.time = shadow.time;
     }
 
     // One light's reflected radiance at a point its shadow ray found lit.
