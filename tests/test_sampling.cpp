@@ -367,7 +367,7 @@ TEST_CASE("render_scene: a fitted renderer refuses what it was compiled without"
 
 TEST_CASE_TEMPLATE("Random::skip: the stream after skipping n draws is the stream after making them", Real, float,
                    double) {
-    for (int n : {0, 1, 2, 5}) {
+    for (int n : {0, 1, 2, 5, 37}) {
         CAPTURE(n);
         prism::Random drawn = prism::Random::for_pixel(11, 2, 7), skipped = drawn;
         for (int i = 0; i < n; ++i) (void)drawn.uniform<Real>();
@@ -378,6 +378,20 @@ TEST_CASE_TEMPLATE("Random::skip: the stream after skipping n draws is the strea
     prism::Random a = prism::Random::for_pixel(1, 1, 0), b = a;
     b.skip<Real>(1);
     CHECK(a.uniform<Real>() != b.uniform<Real>());
+}
+
+TEST_CASE_TEMPLATE("centre_sample: a pinhole's sample skips the lens draws, with the same time and stream after it",
+                   Real, float, double) {
+    for (int x : {0, 3, 799}) {
+        prism::Random drawing = prism::Random::for_pixel(x, 5, 42), skipping = drawing;
+        const prism::CameraSample<Real> drawn = prism::centre_sample<Real>(drawing);
+        const prism::CameraSample<Real> skipped = prism::centre_sample<Real>(skipping, false);
+        CHECK(skipped.pixel == drawn.pixel);
+        CHECK(skipped.time == drawn.time);
+        CHECK(skipped.lens == prism::Vec2<Real>(Real(0.5)));
+        CHECK(drawn.lens != skipped.lens);  // drawn: a point of the aperture, almost never its centre
+        for (int i = 0; i < 4; ++i) REQUIRE(skipping.uniform<Real>() == drawing.uniform<Real>());
+    }
 }
 
 TEST_CASE_TEMPLATE("SceneGeometry::surface: without (u, v) and tangents, without the spawn point, the rest the same",

@@ -54,11 +54,15 @@ void stratified_2d(int n, Random& random, std::vector<Vec2<Real>>& points) {
 }  // namespace detail
 
 // The sample of a one-sample pixel: the pixel centre, as the course's single-sample images are
-// rendered; lens and time still vary between pixels (drawn in that order).
+// rendered; lens and time still vary between pixels (drawn in that order). A camera without an
+// aperture (`lens_read` false) never reads the lens point: the stream steps past its two
+// numbers instead of making them (a tenth of the instructions of a pinhole's camera rays), so
+// every later draw is the one it was.
 template <Scalar Real>
-CameraSample<Real> centre_sample(Random& random) {
+CameraSample<Real> centre_sample(Random& random, bool lens_read = true) {
     CameraSample<Real> sample;
-    sample.lens = random.uniform2<Real>();
+    if (lens_read) sample.lens = random.uniform2<Real>();
+    else random.skip<Real>(2);
     sample.time = random.uniform<Real>();
     return sample;
 }

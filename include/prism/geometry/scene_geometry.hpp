@@ -45,7 +45,7 @@ struct PlaneShape {
     PointWithError<Real> hit_point(const Vec3<Real>& approximate) const {
         const Real d = glm::dot(approximate - point, normal);
         const Vec3<Real> projected = approximate - normal * d;
-        return {projected, gamma<Real>(6) * (glm::abs(approximate) + glm::abs(projected) + glm::abs(point)) +
+        return {projected, gamma<Real>(6) * (abs_each(approximate) + abs_each(projected) + abs_each(point)) +
                                Vec3<Real>(gamma<Real>(2) * std::abs(d))};
     }
 
@@ -384,7 +384,12 @@ public:
                     }
                     static_assert(width <= direct_width, "a group of rays fits the direct lanes");
                     if (!direct_spheres_.empty()) intersect_direct_spheres_lanes(group, group_hits, n, world_hits);
-                    for (int i = 0; i < n; ++i)  // no direct meshes (intersection_batches): the planes
+                    // No direct meshes (intersection_batches): the planes, ray by ray, where there are any.
+                    if (plane_blocks_.empty()) {
+                        found |= world_hits << first;
+                        continue;
+                    }
+                    for (int i = 0; i < n; ++i)
                         if (intersect_direct_meshes<Culling>(group[i], group_hits[i], 0, (world_hits >> i) & 1))
                             found |= std::uint32_t(1) << (first + i);
                 }
@@ -427,6 +432,10 @@ public:
                     }
                     if (found != present && !direct_spheres_.empty())
                         intersect_direct_spheres_lanes<true>(group, nullptr, n, found);
+                    if (plane_blocks_.empty()) {  // no direct meshes (intersection_batches) and no planes
+                        blocked |= found << first;
+                        continue;
+                    }
                     for (int i = 0; i < n; ++i)  // no direct meshes (intersection_batches): the planes
                         if (((found >> i) & 1) || occluded_by_planes(group[i])) blocked |= std::uint32_t(1) << (first + i);
                 }
@@ -596,7 +605,7 @@ public:
                 // axis: clear that along the world normal too.
                 const Vec3<Real> shift = instance.motion * point.time;
                 origin += shift;
-                origin = offset_ray_origin(origin, gamma<Real>(2) * (glm::abs(origin) + glm::abs(shift)),
+                origin = offset_ray_origin(origin, gamma<Real>(2) * (abs_each(origin) + abs_each(shift)),
                                            point.geometric_normal, direction);
             }
         }

@@ -35,7 +35,7 @@ PointWithError<Real> triangle_hit_point(const Vec3<Real>& p0, const Vec3<Real>& 
                                         Real b2) {
     const Real b0 = Real(1) - b1 - b2;
     const Vec3<Real> w0 = b0 * p0, w1 = b1 * p1, w2 = b2 * p2;
-    return {w0 + w1 + w2, gamma<Real>(7) * (glm::abs(w0) + glm::abs(w1) + glm::abs(w2))};
+    return {w0 + w1 + w2, gamma<Real>(7) * (abs_each(w0) + abs_each(w1) + abs_each(w2))};
 }
 
 // The same for vertices stored wider than the traversal precision (DoubleRefine keeps them in
@@ -48,7 +48,7 @@ PointWithError<Real> triangle_hit_point(const Vec3<double>& p0, const Vec3<doubl
                                         Real b1, Real b2) {
     const PointWithError<double> wide = triangle_hit_point(p0, p1, p2, double(b1), double(b2));
     const Vec3<Real> point(wide.point);
-    Vec3<Real> error = gamma<Real>(2) * glm::abs(point);
+    Vec3<Real> error = gamma<Real>(2) * abs_each(point);
     for (int axis = 0; axis < 3; ++axis) error[axis] += next_up(Real(wide.error[axis]));
     return {point, error};
 }
@@ -101,8 +101,8 @@ PointWithError<Real> sphere_hit_point(const Vec3<Real>& center, Real radius, con
     Vec3<Real> local = approximate_point - center;
     local *= radius / glm::length(local);
     const Vec3<Real> point = center + local;
-    Vec3<Real> error = gamma<Real>(5) * glm::abs(local);
-    if (center != Vec3<Real>(0)) error += gamma<Real>(2) * glm::abs(point);
+    Vec3<Real> error = gamma<Real>(5) * abs_each(local);
+    if (center != Vec3<Real>(0)) error += gamma<Real>(2) * abs_each(point);
     return {point, error};
 }
 
@@ -136,7 +136,7 @@ PointWithError<Real> transform_point(const Mat4<Real>& matrix, const PointWithEr
 template <Scalar Real>
 Vec3<Real> offset_ray_origin(const Vec3<Real>& point, const Vec3<Real>& error, const Vec3<Real>& normal,
                              const Vec3<Real>& direction) {
-    const Real distance = glm::dot(glm::abs(normal), error);
+    const Real distance = glm::dot(abs_each(normal), error);
     Vec3<Real> offset = distance * normal;
     if (glm::dot(direction, normal) < 0) offset = -offset;
     Vec3<Real> origin = point + offset;
@@ -250,15 +250,15 @@ Vec3<Real> offset_ray_origin(const InstanceTransforms<Real>& instance, const Poi
     // It starts at the hit point's box; if the offset carries the origin past it, it is widened
     // by twice that offset and the bound recomputed. The offset grows with |o| only by a factor
     // ~ |A M - I|, far below 1, so the second pass fits: the loop is a safeguard, not a search.
-    const Vec3<Real> start = glm::abs(object_point.point) + object_point.error;
+    const Vec3<Real> start = abs_each(object_point.point) + object_point.error;
     Vec3<Real> magnitude = start;
     Vec3<Real> object_origin = object_point.point;
     for (int pass = 0; pass < 4; ++pass) {
         object_origin = offset_ray_origin(object_point.point, object_point.error + instance.round_trip(magnitude),
                                           object_normal, object_direction);
-        const Vec3<Real> reached = glm::abs(object_origin);
+        const Vec3<Real> reached = abs_each(object_origin);
         if (reached.x <= magnitude.x && reached.y <= magnitude.y && reached.z <= magnitude.z) break;
-        magnitude = start + Real(2) * glm::abs(object_origin - object_point.point);
+        magnitude = start + Real(2) * abs_each(object_origin - object_point.point);
     }
     // Out to world space in pbrt's order, which the round-trip bound's first step assumes.
     return transform_point(instance.object_to_world, object_origin);

@@ -22,7 +22,7 @@ struct Watertight {
 
         explicit Prepared(const Ray<Real>& ray) : origin(ray.origin) {
             const Vec3<Real>& d = ray.direction;
-            kz = max_dimension(glm::abs(d));
+            kz = max_dimension(abs_each(d));
             kx = kz == 2 ? 0 : kz + 1;
             ky = kx == 2 ? 0 : kx + 1;
             // Swapping keeps the winding, and so the sign of the edge functions, consistent.

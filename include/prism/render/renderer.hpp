@@ -129,12 +129,13 @@ private:
         constexpr int batch = tile_size;
         std::array<Random, batch> streams;
         std::array<Ray<Real>, batch> rays;
+        const bool lens_read = lens.has_aperture();
         for (int start = begin; start < end; start += batch) {
             const int n = std::min(batch, end - start);
             for (int i = 0; i < n; ++i) {
                 const int x = start + i;
                 streams[std::size_t(i)] = Random::for_pixel(x, y, settings_.seed);
-                const CameraSample<Real> sample = centre_sample<Real>(streams[std::size_t(i)]);
+                const CameraSample<Real> sample = centre_sample<Real>(streams[std::size_t(i)], lens_read);
                 rays[std::size_t(i)] =
                     stored_whole(lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time));
             }

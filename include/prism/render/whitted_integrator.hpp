@@ -111,7 +111,7 @@ struct NoEnvironment {
 template <Scalar Real>
 Vec3<Real> perturb(const Vec3<Real>& direction, Real roughness, const Vec2<Real>& sample) {
     Vec3<Real> helper = direction;
-    const Vec3<Real> magnitude = glm::abs(direction);
+    const Vec3<Real> magnitude = abs_each(direction);
     if (magnitude.x <= magnitude.y && magnitude.x <= magnitude.z) helper.x = 1;
     else if (magnitude.y <= magnitude.z) helper.y = 1;
     else helper.z = 1;

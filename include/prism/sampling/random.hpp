@@ -63,10 +63,18 @@ public:
     // Steps the stream past `count` uniform<Real>() draws without making them: a caller that
     // needs no sample (a point light) skips its draws this way, so that every later draw
     // (a glossy reflection's) is the one it would have been.
+    // The k steps are taken as one: state m^k + increment (m^(k-1) + ... + 1), mod 2^64 as each
+    // step is, so the state is the same bits. The coefficients depend on k alone and fold to
+    // constants where k does; the state then waits for one multiplication, not k in a row.
     template <Scalar Real>
     constexpr void skip(int count) {
         const int steps = sizeof(Real) == 4 ? count : 2 * count;
-        for (int i = 0; i < steps; ++i) state_ = state_ * multiplier + increment_;
+        std::uint64_t power = 1, sum = 0;
+        for (int i = 0; i < steps; ++i) {
+            sum += power;
+            power *= multiplier;
+        }
+        state_ = state_ * power + increment_ * sum;
     }
 
     // Uniform integer in [0, n) (Lemire's multiply-shift; the bias is below 2^-32 n).
