@@ -12,6 +12,7 @@
 
 #include <tbb/global_control.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -302,6 +303,66 @@ TEST_CASE_TEMPLATE("Renderer: a pixel is its camera samples' filter-weighted mea
     }
 }
 
+TEST_CASE_TEMPLATE("Renderer: a row's mirrors and conductors, their reflections traced side by side, give each pixel's radiance bit for bit",
+                   Real, float, double) {
+    // A scene the geometry tests side by side (a top level of spheres, a floor of two world-space
+    // triangles): one_sample_row's rows, radiance_row's shadow rays and its deferred reflections
+    // (intersect_each at depth 1, then shade). Point lights, mirrors and conductors without
+    // roughness draw nothing, so radiance() along each pixel's centre ray (the recursive trace,
+    // a ray at a time) must give every pixel's bits. Rows of both materials, reflections that
+    // meet a sphere, the floor or nothing, and chains of them to MaxRecursionDepth.
+    scene::Scene world;
+    scene::Camera camera = looking_down_z(40, 28);
+    camera.position = {0, 1.5, 10};
+    world.cameras.push_back(camera);
+    scene::Material mirror = matte(0.2);
+    mirror.type = scene::MaterialType::mirror;
+    mirror.mirror = glm::dvec3(0.5, 0.6, 0.7);
+    mirror.specular = glm::dvec3(0.4);
+    mirror.phong_exponent = 20;
+    scene::Material conductor = matte(0.1);
+    conductor.type = scene::MaterialType::conductor;
+    conductor.mirror = glm::dvec3(0.9, 0.8, 0.6);
+    conductor.refraction_index = 0.37;
+    conductor.absorption_index = 2.8;
+    world.materials = {mirror, conductor, matte(0.7)};
+    world.spheres.push_back({"mirror ball", 0, {-1.2, 0, 0}, 1, glm::dmat4(1.0)});
+    world.spheres.push_back({"copper ball", 1, {1.3, 0.2, -0.5}, 1.1, glm::dmat4(1.0)});
+    world.spheres.push_back({"matte ball", 2, {0, 2.2, -2}, 0.6, glm::dmat4(1.0)});
+    scene::Mesh floor;
+    floor.material = 0;
+    floor.positions = {{-8, -1, -8}, {8, -1, -8}, {8, -1, 8}, {-8, -1, 8}};
+    floor.triangles = {{0, 2, 1}, {0, 3, 2}};
+    world.meshes.push_back(floor);
+    world.point_lights.push_back({"key", {3, 6, 4}, {60, 60, 60}});
+    world.point_lights.push_back({"fill", {-4, 3, 2}, {15, 12, 10}});
+    world.ambient_light = glm::dvec3(0.05);
+    using Punctual = prism::Config<Real, prism::WideBvh<prism::Watertight, 8>, prism::PointLightSet>;
+    REQUIRE(prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>(world).intersection_batches());
+    world.max_recursion_depth = 0;
+    const prism::Image unreflected = prism::Renderer<Punctual>(world).render(world.cameras[0]);
+    for (const int depth : {1, 4}) {
+        CAPTURE(depth);
+        world.max_recursion_depth = depth;
+        const prism::Renderer<Punctual> renderer(world);
+        const prism::Image image = renderer.render(world.cameras[0]);
+        const prism::ThinLensCamera<Real> lens(camera, camera.width, camera.height);
+        int mismatches = 0, reflecting = 0;
+        for (int y = 0; y < camera.height; ++y)
+            for (int x = 0; x < camera.width; ++x) {
+                prism::Random random = prism::Random::for_pixel(x, y, 0);
+                const prism::CameraSample<Real> sample = prism::centre_sample<Real>(random);
+                const prism::Ray<Real> ray =
+                    lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time);
+                const glm::vec3 expected(prism::Vec3<Real>(0) + renderer.radiance(ray));
+                mismatches += std::memcmp(&expected, &image(x, y), sizeof expected) != 0;
+                reflecting += image(x, y) != unreflected(x, y);  // a reflection brought something back
+            }
+        CHECK(mismatches == 0);
+        CHECK(reflecting > 200);
+    }
+}
+
 TEST_CASE_TEMPLATE("Whitted: seven point lights add up, in their order, as each alone gives it, bit for bit", Real,
                    float, double) {
     // A guard for any reordering of the light loop (whole9 measured batching the lights' shadow
@@ -380,18 +441,41 @@ TEST_CASE_TEMPLATE("Random::skip: the stream after skipping n draws is the strea
     CHECK(a.uniform<Real>() != b.uniform<Real>());
 }
 
-TEST_CASE_TEMPLATE("centre_sample: a pinhole's sample skips the lens draws, with the same time and stream after it",
+TEST_CASE_TEMPLATE("Random::for_row and centre_rays: a pinhole row's streams and rays, lane by lane, as pixel by pixel",
                    Real, float, double) {
-    for (int x : {0, 3, 799}) {
-        prism::Random drawing = prism::Random::for_pixel(x, 5, 42), skipping = drawing;
-        const prism::CameraSample<Real> drawn = prism::centre_sample<Real>(drawing);
-        const prism::CameraSample<Real> skipped = prism::centre_sample<Real>(skipping, false);
-        CHECK(skipped.pixel == drawn.pixel);
-        CHECK(skipped.time == drawn.time);
-        CHECK(skipped.lens == prism::Vec2<Real>(Real(0.5)));
-        CHECK(drawn.lens != skipped.lens);  // drawn: a point of the aperture, almost never its centre
-        for (int i = 0; i < 4; ++i) REQUIRE(skipping.uniform<Real>() == drawing.uniform<Real>());
-    }
+    // one_sample_row's pinhole path: for_row's streams past the lens draws, the time drawn
+    // from each, and ThinLensCamera::centre_rays, against for_pixel, centre_sample and ray at
+    // every pixel centre of rows anywhere in the image (a row of 16 lanes that runs past its
+    // right edge included), for two seeds.
+    scene::Camera camera = looking_down_z(37, 9);
+    camera.gaze = glm::normalize(glm::dvec3(0.3, -0.2, -1));
+    camera.up = {0.1, 1, 0};
+    const prism::ThinLensCamera<Real> lens(camera, camera.width, camera.height);
+    REQUIRE(!lens.has_aperture());
+    for (const std::uint64_t seed : {std::uint64_t(0), std::uint64_t(977)})
+        for (int y = 0; y < camera.height; ++y)
+            for (int x0 = 0; x0 < camera.width; x0 += 16) {
+                std::array<prism::Random, 16> streams;
+                std::array<Real, 16> times;
+                prism::Random::for_row<Real>(x0, y, seed, 2, streams, times);
+                std::array<prism::Ray<Real>, 16> rays;
+                lens.centre_rays(x0, y, times, rays);
+                for (int i = 0; i < 16; ++i) {
+                    CAPTURE(x0 + i);
+                    prism::Random random = prism::Random::for_pixel(x0 + i, y, seed);
+                    const prism::CameraSample<Real> sample = prism::centre_sample<Real>(random);
+                    const prism::Ray<Real> ray =
+                        lens.ray(Real(x0 + i) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time);
+                    const prism::Ray<Real>& row = rays[std::size_t(i)];
+                    REQUIRE(std::memcmp(&row.origin, &ray.origin, sizeof ray.origin) == 0);
+                    REQUIRE(std::memcmp(&row.direction, &ray.direction, sizeof ray.direction) == 0);
+                    REQUIRE(std::memcmp(&row.time, &ray.time, sizeof ray.time) == 0);
+                    REQUIRE(row.t_min == ray.t_min);
+                    REQUIRE(row.t_max == ray.t_max);
+                    // The streams go on alike.
+                    for (int k = 0; k < 3; ++k) REQUIRE(streams[std::size_t(i)].template uniform<Real>() == random.uniform<Real>());
+                }
+            }
 }
 
 TEST_CASE_TEMPLATE("SceneGeometry::surface: without (u, v) and tangents, without the spawn point, the rest the same",

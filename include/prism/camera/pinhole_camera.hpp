@@ -5,6 +5,10 @@
 
 #include <prism/geometry/ray.hpp>
 #include <prism/scene/scene.hpp>
+#include <prism/simd/pack.hpp>
+
+#include <array>
+#include <cmath>
 
 namespace prism {
 
@@ -34,6 +38,37 @@ public:
     // the left, y in [0, height) from the top; pixel centres are at +0.5.
     Ray<Real> ray(Real x, Real y) const {
         return {origin_, unit_vector(top_left_ + x * step_u_ + y * step_v_), Real(0), infinity<Real>};
+    }
+
+    // ray(Real(x0 + i) + 0.5, Real(y) + 0.5) for i < N, the pixel centres of a row, at the
+    // instants times[i]: each the bits ray gives it (the same operations in the same order,
+    // lane by lane, -ffp-contract=off), in plain loops the compiler vectorises, with the square
+    // roots and divisions of a row side by side.
+    // (simd::Pack: GCC does not vectorise std::sqrt itself without -fno-math-errno.)
+    template <std::size_t N>
+    void centre_rays(int x0, int y, const std::array<Real, N>& times, std::array<Ray<Real>, N>& rays) const {
+        using Lanes = simd::Pack<Real, 8>;
+        static_assert(N % 8 == 0);
+        const Vec3<Real> down = (Real(y) + Real(0.5)) * step_v_;
+        const Lanes left[3] = {Lanes::broadcast(top_left_.x), Lanes::broadcast(top_left_.y), Lanes::broadcast(top_left_.z)};
+        const Lanes step[3] = {Lanes::broadcast(step_u_.x), Lanes::broadcast(step_u_.y), Lanes::broadcast(step_u_.z)};
+        const Lanes below[3] = {Lanes::broadcast(down.x), Lanes::broadcast(down.y), Lanes::broadcast(down.z)};
+        alignas(64) std::array<Real, N> direction[3];
+        for (std::size_t first = 0; first < N; first += 8) {
+            alignas(64) Real centres[8];
+            for (int i = 0; i < 8; ++i) centres[i] = Real(x0 + static_cast<int>(first) + i) + Real(0.5);
+            const Lanes x = Lanes::load(centres);
+            // top_left_ + x * step_u_ + y * step_v_, as glm sums it (left to right), and
+            // unit_vector's v * (1 / sqrt(v . v)).
+            Lanes along[3];
+            for (int axis = 0; axis < 3; ++axis) along[axis] = (left[axis] + x * step[axis]) + below[axis];
+            const Lanes scale =
+                Lanes::broadcast(Real(1)) / simd::sqrt((along[0] * along[0] + along[1] * along[1]) + along[2] * along[2]);
+            for (int axis = 0; axis < 3; ++axis) (along[axis] * scale).store(direction[axis].data() + first);
+        }
+        for (std::size_t i = 0; i < N; ++i)
+            rays[i] = Ray<Real>{origin_, Vec3<Real>(direction[0][i], direction[1][i], direction[2][i]), Real(0),
+                                infinity<Real>, times[i]};
     }
 
     // The camera's frame: position, the image plane's right (u) and up (v) axes, and the unit

@@ -54,15 +54,11 @@ void stratified_2d(int n, Random& random, std::vector<Vec2<Real>>& points) {
 }  // namespace detail
 
 // The sample of a one-sample pixel: the pixel centre, as the course's single-sample images are
-// rendered; lens and time still vary between pixels (drawn in that order). A camera without an
-// aperture (`lens_read` false) never reads the lens point: the stream steps past its two
-// numbers instead of making them (a tenth of the instructions of a pinhole's camera rays), so
-// every later draw is the one it was.
+// rendered; lens and time still vary between pixels (drawn in that order).
 template <Scalar Real>
-CameraSample<Real> centre_sample(Random& random, bool lens_read = true) {
+CameraSample<Real> centre_sample(Random& random) {
     CameraSample<Real> sample;
-    if (lens_read) sample.lens = random.uniform2<Real>();
-    else random.skip<Real>(2);
+    sample.lens = random.uniform2<Real>();
     sample.time = random.uniform<Real>();
     return sample;
 }

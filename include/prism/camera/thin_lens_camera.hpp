@@ -35,6 +35,13 @@ public:
         return ray;
     }
 
+    // The rays of a row's pixel centres (PinholeCamera::centre_rays), for a camera without an
+    // aperture, whose rays are the pinhole's.
+    template <std::size_t N>
+    void centre_rays(int x0, int y, const std::array<Real, N>& times, std::array<Ray<Real>, N>& rays) const {
+        pinhole_.centre_rays(x0, y, times, rays);
+    }
+
 private:
     PinholeCamera<Real> pinhole_;
     Real aperture_;

@@ -31,8 +31,8 @@ struct PointWithError {
 // exactly 1, the point moves by (sum - 1) p_i, whose component along the normal is
 // (sum - 1) (n . p_hit), within a few u of sum |b_i p_i|; gamma(7) covers it.
 template <Scalar Real>
-PointWithError<Real> triangle_hit_point(const Vec3<Real>& p0, const Vec3<Real>& p1, const Vec3<Real>& p2, Real b1,
-                                        Real b2) {
+[[gnu::always_inline]] inline PointWithError<Real> triangle_hit_point(const Vec3<Real>& p0, const Vec3<Real>& p1,
+                                                                      const Vec3<Real>& p2, Real b1, Real b2) {
     const Real b0 = Real(1) - b1 - b2;
     const Vec3<Real> w0 = b0 * p0, w1 = b1 * p1, w2 = b2 * p2;
     return {w0 + w1 + w2, gamma<Real>(7) * (abs_each(w0) + abs_each(w1) + abs_each(w2))};
@@ -68,9 +68,11 @@ PointWithError<Real> triangle_hit_point(const Vec3<double>& p0, const Vec3<doubl
 // valid hits: a 1e-7 triangle at distance 1 in float, a leak-test ray, 6% of the Reintersect
 // protocol's incoming rays. c = 16: in that protocol c = 4 already leaves no re-hit over 9
 // seeds; the estimate above gives ~18. The margin is taken in the precision the triangle is
-// tested in (Vertex: double for DoubleRefine).
+// tested in (Vertex: double for DoubleRefine). Forced inline: out of line, the call and its
+// vectors passed through memory cost hw1 simple_shading 2% of its instructions (GCC inlines it
+// or not as the shading code around it grows).
 template <Scalar Real, Scalar Vertex>
-PointWithError<Real> triangle_spawn_point(const Vec3<Vertex>& p0, const Vec3<Vertex>& p1, const Vec3<Vertex>& p2,
+[[gnu::always_inline]] inline PointWithError<Real> triangle_spawn_point(const Vec3<Vertex>& p0, const Vec3<Vertex>& p1, const Vec3<Vertex>& p2,
                                           Real b1, Real b2) {
     PointWithError<Real> result = triangle_hit_point(p0, p1, p2, b1, b2);
     // In double for both precisions: R^3 overflows float for coordinates past ~1e12.

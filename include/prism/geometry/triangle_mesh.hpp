@@ -287,7 +287,7 @@ public:
     // The hit point computed from the barycentrics, with the error bound a leaving ray must
     // clear (geometry/surface_error.hpp), in object space and the precision the triangle is
     // stored in.
-    PointWithError<Real> spawn_point(const Hit<Real>& hit) const {
+    [[gnu::always_inline]] PointWithError<Real> spawn_point(const Hit<Real>& hit) const {
         const auto& p = triangles_[hit.primitive];
         return triangle_spawn_point<Real>(p[0], p[1], p[2], hit.b1, hit.b2);
     }

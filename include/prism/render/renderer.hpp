@@ -129,15 +129,24 @@ private:
         constexpr int batch = tile_size;
         std::array<Random, batch> streams;
         std::array<Ray<Real>, batch> rays;
-        const bool lens_read = lens.has_aperture();
         for (int start = begin; start < end; start += batch) {
             const int n = std::min(batch, end - start);
-            for (int i = 0; i < n; ++i) {
-                const int x = start + i;
-                streams[std::size_t(i)] = Random::for_pixel(x, y, settings_.seed);
-                const CameraSample<Real> sample = centre_sample<Real>(streams[std::size_t(i)], lens_read);
-                rays[std::size_t(i)] =
-                    stored_whole(lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time));
+            if (!lens.has_aperture()) {
+                // A pinhole, which never reads the lens point: the row's streams stepped past
+                // the lens's two draws, and its rays, lane by lane
+                // (Random::for_row, ThinLensCamera::centre_rays), the time drawn between them,
+                // as centre_sample draws it. Lanes past the row's end are made and not used.
+                std::array<Real, batch> times;
+                Random::for_row<Real>(start, y, settings_.seed, 2, streams, times);
+                lens.centre_rays(start, y, times, rays);
+            } else {
+                for (int i = 0; i < n; ++i) {
+                    const int x = start + i;
+                    streams[std::size_t(i)] = Random::for_pixel(x, y, settings_.seed);
+                    const CameraSample<Real> sample = centre_sample<Real>(streams[std::size_t(i)]);
+                    rays[std::size_t(i)] = stored_whole(
+                        lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time));
+                }
             }
             // Where the geometry tests rays side by side (SceneGeometry::intersection_batches),
             // the row's closest hits first, then its shading: the row's shadow rays side by side

@@ -255,6 +255,14 @@ public:
             for (std::uint32_t hit = geometry_.occluded_side_by_side(packed.data(), n); hit != 0; hit &= hit - 1)
                 blocked[std::size_t(owner[std::size_t(std::countr_zero(hit))])] |= std::uint32_t(1) << k;
         }
+        // Mirrors' and conductors' reflected rays, traced after the row's shading with their
+        // closest hits found side by side (intersect_each, as trace's own intersection finds
+        // them at depth 1); each pixel draws from its own stream, so its draws keep their order.
+        Unconstructed<Ray<Real>, row_width> reflections;
+        std::array<Vec3<Real>, row_width> weights;
+        std::array<Real, row_width> travelled;
+        std::array<int, row_width> reflecting;  // the ray's pixel
+        int reflected_count = 0;
         for (int i = 0; i < count; ++i) {
             if (!((found >> i) & 1)) continue;
             RowPoint& at = points[std::size_t(i)];
@@ -272,8 +280,34 @@ public:
                 at.color += direct;
             }
             CameraPath path = make_path(i);
+            if ((material.type == scene::MaterialType::mirror || material.type == scene::MaterialType::conductor) &&
+                0 < settings_.max_recursion_depth) {
+                // reflect_and_absorb's mirror and conductor, the trace deferred (no medium: only
+                // dielectrics have one).
+                const std::size_t j = std::size_t(reflected_count++);
+                Real cos_incident;
+                reflections.make(j, reflection_of(rays[i], at.point, material, at.normal, path, at.origins, cos_incident));
+                weights[j] = reflection_weight(material, cos_incident);
+                travelled[j] = Real(0) + hits[i].t;
+                reflecting[j] = i;
+                radiance[i] = at.color;
+                continue;
+            }
             radiance[i] = reflect_and_absorb(rays[i], hits[i], at.point, material, at.normal, at.front_face,
                                              at.inside_medium, at.color, 0, path, Real(0) + hits[i].t, at.origins);
+        }
+        if (reflected_count == 0) return;
+        std::array<Hit<Real>, row_width> reflection_hits;
+        const std::uint32_t met =
+            geometry_.template intersect_each<BackfaceCulling::none>(reflections.data(), reflection_hits.data(), reflected_count);
+        for (int j = 0; j < reflected_count; ++j) {
+            const int i = reflecting[std::size_t(j)];
+            CameraPath path = make_path(i);
+            const Ray<Real>& reflection = reflections[std::size_t(j)];
+            const Vec3<Real> traced = ((met >> j) & 1) ? shade_apart(reflection, reflection_hits[std::size_t(j)], 1,
+                                                                     path, travelled[std::size_t(j)])
+                                                       : escaped(reflection.direction, 1, path.pixel_uv);
+            radiance[i] += weights[std::size_t(j)] * traced;
         }
     }
 
@@ -320,6 +354,13 @@ private:
                                   travelled, origins);
     }
 
+    // shade, out of line: for radiance_row's deferred reflections, which inlining all of shade
+    // made too large for GCC to keep the row's own point and shading code inline.
+    [[gnu::noinline]] Vec3<Real> shade_apart(const Ray<Real>& ray, const Hit<Real>& hit, int depth, CameraPath& path,
+                                             Real travelled) const {
+        return shade(ray, hit, depth, path, travelled);
+    }
+
     // shade's work past the direct lighting: the reflected (and refracted) rays traced, and
     // Beer's law inside a medium; `color` is the point's own (emitted, ambient, direct).
     [[gnu::always_inline]] Vec3<Real> reflect_and_absorb(const Ray<Real>& ray, const Hit<Real>& hit,
@@ -327,26 +368,18 @@ private:
                                                          const Vec3<Real>& normal, bool front_face, bool inside_medium,
                                                          Vec3<Real> color, int depth, CameraPath& path, Real travelled,
                                                          SpawnOrigins& origins) const {
-        Random& random = path.random;
         const Vec3<Real>& d = ray.direction;
         // Blinn-Phong surfaces spawn no rays; the others reflect (and dielectrics refract).
         if (depth < settings_.max_recursion_depth && material.type != scene::MaterialType::blinn_phong) {
             using scene::MaterialType;
-            const Real cos_incident = -glm::dot(d, normal);
-            Vec3<Real> reflected = d + 2 * cos_incident * normal;
-            if (material.roughness > 0) reflected = perturb(reflected, material.roughness, random.uniform2<Real>());
-            const Ray<Real> reflection = stored_whole(leaving(point, normal, reflected, ray.time, origins));
+            Real cos_incident;
+            const Ray<Real> reflection = reflection_of(ray, point, material, normal, path, origins, cos_incident);
             switch (material.type) {
                 case MaterialType::blinn_phong: break;
                 case MaterialType::mirror:
-                    color += material.mirror * trace(reflection, depth + 1, path, travelled);
+                case MaterialType::conductor:
+                    color += reflection_weight(material, cos_incident) * trace(reflection, depth + 1, path, travelled);
                     break;
-                case MaterialType::conductor: {
-                    const Real fresnel = fresnel_conductor(std::max(cos_incident, Real(0)), material.refraction_index,
-                                                           material.absorption_index);
-                    color += fresnel * material.mirror * trace(reflection, depth + 1, path, travelled);
-                    break;
-                }
                 case MaterialType::dielectric:
                     color += dielectric(point, d, normal, cos_incident, front_face, material, reflection, depth,
                                         path, travelled, origins);
@@ -360,6 +393,28 @@ private:
             color *= transmittance;
         }
         return color;
+    }
+
+    // The ray a surface that is not Blinn-Phong reflects toward (perturbed by its roughness,
+    // drawing from the path's stream), and the cosine of incidence it was made with.
+    [[gnu::always_inline]] Ray<Real> reflection_of(const Ray<Real>& ray, const SurfacePoint<Real>& point,
+                                                   const Material<Real>& material, const Vec3<Real>& normal,
+                                                   CameraPath& path, SpawnOrigins& origins, Real& cos_incident) const {
+        const Vec3<Real>& d = ray.direction;
+        cos_incident = -glm::dot(d, normal);
+        Vec3<Real> reflected = d + 2 * cos_incident * normal;
+        if (material.roughness > 0) reflected = perturb(reflected, material.roughness, path.random.template uniform2<Real>());
+        return stored_whole(leaving(point, normal, reflected, ray.time, origins));
+    }
+
+    // What a mirror's or a conductor's reflected radiance is multiplied by: its MirrorReflectance,
+    // times the conductor's Fresnel reflectance (fresnel * mirror, then the radiance: the
+    // products in the order the expression always took them).
+    [[gnu::always_inline]] Vec3<Real> reflection_weight(const Material<Real>& material, Real cos_incident) const {
+        if (material.type != scene::MaterialType::conductor) return material.mirror;
+        const Real fresnel =
+            fresnel_conductor(std::max(cos_incident, Real(0)), material.refraction_index, material.absorption_index);
+        return fresnel * material.mirror;
     }
 
     bool intersect(Ray<Real>& ray, int depth, Hit<Real>& hit) const {
