@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -329,6 +330,7 @@ TEST_CASE_TEMPLATE("Renderer: a row's mirrors and conductors, their reflections 
     world.spheres.push_back({"mirror ball", 0, {-1.2, 0, 0}, 1, glm::dmat4(1.0)});
     world.spheres.push_back({"copper ball", 1, {1.3, 0.2, -0.5}, 1.1, glm::dmat4(1.0)});
     world.spheres.push_back({"matte ball", 2, {0, 2.2, -2}, 0.6, glm::dmat4(1.0)});
+    world.planes.push_back({"wall", 2, {0, 0, -6}, {0, 0, 1}, glm::dmat4(1.0)});  // what the floor mirrors
     scene::Mesh floor;
     floor.material = 0;
     floor.positions = {{-8, -1, -8}, {8, -1, -8}, {8, -1, 8}, {-8, -1, 8}};
@@ -341,13 +343,14 @@ TEST_CASE_TEMPLATE("Renderer: a row's mirrors and conductors, their reflections 
     REQUIRE(prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>(world).intersection_batches());
     world.max_recursion_depth = 0;
     const prism::Image unreflected = prism::Renderer<Punctual>(world).render(world.cameras[0]);
+    std::optional<prism::Image> once;
     for (const int depth : {1, 4}) {
         CAPTURE(depth);
         world.max_recursion_depth = depth;
         const prism::Renderer<Punctual> renderer(world);
         const prism::Image image = renderer.render(world.cameras[0]);
         const prism::ThinLensCamera<Real> lens(camera, camera.width, camera.height);
-        int mismatches = 0, reflecting = 0;
+        int mismatches = 0, reflecting = 0, chained = 0;
         for (int y = 0; y < camera.height; ++y)
             for (int x = 0; x < camera.width; ++x) {
                 prism::Random random = prism::Random::for_pixel(x, y, 0);
@@ -357,9 +360,14 @@ TEST_CASE_TEMPLATE("Renderer: a row's mirrors and conductors, their reflections 
                 const glm::vec3 expected(prism::Vec3<Real>(0) + renderer.radiance(ray));
                 mismatches += std::memcmp(&expected, &image(x, y), sizeof expected) != 0;
                 reflecting += image(x, y) != unreflected(x, y);  // a reflection brought something back
+                if (once) chained += image(x, y) != (*once)(x, y);  // and a reflection of a reflection
             }
         CHECK(mismatches == 0);
-        CHECK(reflecting > 200);
+        // Measured: 384 pixels at depth 1 and 408 at depth 4 (of 1120), 68 changed by the
+        // deeper bounces; the bounds say the scene exercises what the test is for.
+        CHECK(reflecting > 300);
+        if (once) CHECK(chained > 30);
+        once = image;
     }
 }
 
@@ -446,9 +454,12 @@ TEST_CASE_TEMPLATE("Random::for_row and centre_rays: a pinhole row's streams and
     // one_sample_row's pinhole path: for_row's streams past the lens draws, the time drawn
     // from each, and ThinLensCamera::centre_rays, against for_pixel, centre_sample and ray at
     // every pixel centre of rows anywhere in the image (a row of 16 lanes that runs past its
-    // right edge included), for two seeds.
+    // right edge included), for two seeds. The camera is read at run time, as from a file: with
+    // its frame known at compile time GCC 12 folds ray()'s sums into a vfmaddsub, fused
+    // whatever -ffp-contract says (seen here in double), and the reference is no longer ray().
+    volatile double tilt = 0.3;
     scene::Camera camera = looking_down_z(37, 9);
-    camera.gaze = glm::normalize(glm::dvec3(0.3, -0.2, -1));
+    camera.gaze = glm::normalize(glm::dvec3(tilt, -0.2, -1));
     camera.up = {0.1, 1, 0};
     const prism::ThinLensCamera<Real> lens(camera, camera.width, camera.height);
     REQUIRE(!lens.has_aperture());
@@ -468,6 +479,7 @@ TEST_CASE_TEMPLATE("Random::for_row and centre_rays: a pinhole row's streams and
                         lens.ray(Real(x0 + i) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time);
                     const prism::Ray<Real>& row = rays[std::size_t(i)];
                     REQUIRE(std::memcmp(&row.origin, &ray.origin, sizeof ray.origin) == 0);
+                    CAPTURE(y);
                     REQUIRE(std::memcmp(&row.direction, &ray.direction, sizeof ray.direction) == 0);
                     REQUIRE(std::memcmp(&row.time, &ray.time, sizeof ray.time) == 0);
                     REQUIRE(row.t_min == ray.t_min);
