@@ -344,7 +344,7 @@ TEST_CASE_TEMPLATE("Renderer: a row's mirrors and conductors, their reflections 
     world.max_recursion_depth = 0;
     const prism::Image unreflected = prism::Renderer<Punctual>(world).render(world.cameras[0]);
     std::optional<prism::Image> once;
-    for (const int depth : {1, 4}) {
+    for (const int depth : {1, 4, 10}) {  // 10: past the rows' depth, the last bounces one by one
         CAPTURE(depth);
         world.max_recursion_depth = depth;
         const prism::Renderer<Punctual> renderer(world);
@@ -366,7 +366,7 @@ TEST_CASE_TEMPLATE("Renderer: a row's mirrors and conductors, their reflections 
         // Measured: 384 pixels at depth 1 and 408 at depth 4 (of 1120), 68 changed by the
         // deeper bounces; the bounds say the scene exercises what the test is for.
         CHECK(reflecting > 300);
-        if (once) CHECK(chained > 30);
+        if (depth == 4) CHECK(chained > 30);
         once = image;
     }
 }

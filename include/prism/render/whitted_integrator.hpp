@@ -196,6 +196,25 @@ public:
             }
             return;
         }
+        Unconstructed<CameraPath, row_width> paths;
+        for (int i = 0; i < count; ++i) paths.make_from(std::size_t(i), [&] { return make_path(i); });
+        shade_row<true>(rays, hits, found, count, paths.data(), nullptr, 0, radiance);
+    }
+
+private:
+    // How deep radiance_row follows a row's mirror and conductor reflections as rows (a
+    // shade_row frame each, some 20 kB of a worker's stack); deeper ones are traced one by one.
+    static constexpr int row_depth = 8;
+
+    // radiance_row's rows at `depth`: rays[i] has travelled `travelled[i]` before its origin
+    // (camera rays, `Primary`: none, and depth 0) and draws from paths[i]. shade's work, pass
+    // by pass across the row.
+    template <bool Primary>
+        requires(!textured<Textures, Real> && std::is_same_v<LightSetT, LightSet<Real, PointLight>>)
+    void shade_row(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count, CameraPath* paths,
+                   const Real* travelled, int depth, Vec3<Real>* radiance) const {
+        if constexpr (Primary) depth = 0;
+        const std::vector<PointLight<Real>>& lights = *lights_.template of_type<PointLight>();
         // What shade knows of a point before its direct lighting (the point made in place, the
         // rest of the record after it: value-initialised whole, the record had cost 5% of
         // simple_shading's instructions), and per light what that lighting draws.
@@ -211,9 +230,9 @@ public:
         std::array<std::array<Real, row_width>, row_lights> cosines;
         std::array<Unconstructed<Ray<Real>, row_width>, row_lights> shadows;  // per light, per ray
         for (int i = 0; i < count; ++i) {
-            CameraPath path = make_path(i);
+            CameraPath& path = paths[i];
             if (!((found >> i) & 1)) {
-                radiance[i] = escaped(rays[i].direction, 0, path.pixel_uv);
+                radiance[i] = escaped(rays[i].direction, depth, path.pixel_uv);
                 continue;
             }
             const Ray<Real>& ray = rays[i];
@@ -257,11 +276,13 @@ public:
         }
         // Mirrors' and conductors' reflected rays, traced after the row's shading with their
         // closest hits found side by side (intersect_each, as trace's own intersection finds
-        // them at depth 1); each pixel draws from its own stream, so its draws keep their order.
+        // them below depth 0) and shaded as a row again, down to row_depth; each pixel draws
+        // from its own stream, so its draws keep their order.
         Unconstructed<Ray<Real>, row_width> reflections;
+        Unconstructed<CameraPath, row_width> reflection_paths;
         std::array<Vec3<Real>, row_width> weights;
-        std::array<Real, row_width> travelled;
-        std::array<int, row_width> reflecting;  // the ray's pixel
+        std::array<Real, row_width> reached;  // travelled to the reflection's origin
+        std::array<int, row_width> reflecting;  // the ray's index in this row
         int reflected_count = 0;
         for (int i = 0; i < count; ++i) {
             if (!((found >> i) & 1)) continue;
@@ -279,36 +300,44 @@ public:
                 }
                 at.color += direct;
             }
-            CameraPath path = make_path(i);
+            CameraPath& path = paths[i];
+            const Real travelled_here = (Primary ? Real(0) : travelled[i]) + hits[i].t;  // shade's travelled += hit.t
             if ((material.type == scene::MaterialType::mirror || material.type == scene::MaterialType::conductor) &&
-                0 < settings_.max_recursion_depth) {
+                depth < settings_.max_recursion_depth) {
                 // reflect_and_absorb's mirror and conductor, the trace deferred (no medium: only
                 // dielectrics have one).
                 const std::size_t j = std::size_t(reflected_count++);
                 Real cos_incident;
                 reflections.make(j, reflection_of(rays[i], at.point, material, at.normal, path, at.origins, cos_incident));
+                reflection_paths.make(j, path);
                 weights[j] = reflection_weight(material, cos_incident);
-                travelled[j] = Real(0) + hits[i].t;
+                reached[j] = travelled_here;
                 reflecting[j] = i;
                 radiance[i] = at.color;
                 continue;
             }
             radiance[i] = reflect_and_absorb(rays[i], hits[i], at.point, material, at.normal, at.front_face,
-                                             at.inside_medium, at.color, 0, path, Real(0) + hits[i].t, at.origins);
+                                             at.inside_medium, at.color, depth, path, travelled_here, at.origins);
         }
         if (reflected_count == 0) return;
         std::array<Hit<Real>, row_width> reflection_hits;
         const std::uint32_t met =
             geometry_.template intersect_each<BackfaceCulling::none>(reflections.data(), reflection_hits.data(), reflected_count);
-        for (int j = 0; j < reflected_count; ++j) {
-            const int i = reflecting[std::size_t(j)];
-            CameraPath path = make_path(i);
-            const Ray<Real>& reflection = reflections[std::size_t(j)];
-            const Vec3<Real> traced = ((met >> j) & 1) ? shade_apart(reflection, reflection_hits[std::size_t(j)], 1,
-                                                                     path, travelled[std::size_t(j)])
-                                                       : escaped(reflection.direction, 1, path.pixel_uv);
-            radiance[i] += weights[std::size_t(j)] * traced;
+        std::array<Vec3<Real>, row_width> traced;
+        if (depth + 1 < row_depth) {
+            shade_row<false>(reflections.data(), reflection_hits.data(), met, reflected_count, reflection_paths.data(),
+                             reached.data(), depth + 1, traced.data());
+        } else {
+            for (int j = 0; j < reflected_count; ++j) {
+                const Ray<Real>& reflection = reflections[std::size_t(j)];
+                CameraPath& path = reflection_paths[std::size_t(j)];
+                traced[std::size_t(j)] = ((met >> j) & 1) ? shade_apart(reflection, reflection_hits[std::size_t(j)],
+                                                                        depth + 1, path, reached[std::size_t(j)])
+                                                          : escaped(reflection.direction, depth + 1, path.pixel_uv);
+            }
         }
+        for (int j = 0; j < reflected_count; ++j)
+            radiance[reflecting[std::size_t(j)]] += weights[std::size_t(j)] * traced[std::size_t(j)];
     }
 
 private:
