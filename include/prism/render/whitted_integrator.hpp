@@ -178,9 +178,10 @@ public:
     // radiance_at for a row's camera rays together (count <= row_width), in point-lit
     // renderers without textures: every hit's shadow rays are made first, then each light's
     // are tested side by side across the row (SceneGeometry::occluded_side_by_side: a ray in
-    // each SIMD lane), then each point is shaded and its reflections traced. The same draws,
-    // rays, tests and sums as radiance_at, so the same bits. `make_path(i)`: ray i's
-    // CameraPath (its pixel's stream, by reference).
+    // each SIMD lane), then each point is shaded; the mirrors' and conductors' reflected rays
+    // then go on as a row of their own (shade_row). The same draws, rays, tests and sums as
+    // radiance_at, so the same bits. `make_path(i)`: ray i's CameraPath (its pixel's stream,
+    // by reference).
     static constexpr int row_width = 16;
     static constexpr std::size_t row_lights = 8;
     template <class MakePath>
