@@ -42,9 +42,9 @@ public:
 
     // ray(Real(x0 + i) + 0.5, Real(y) + 0.5) for i < N, the pixel centres of a row, at the
     // instants times[i]: each the bits ray gives it (the same operations in the same order,
-    // lane by lane, -ffp-contract=off), in plain loops the compiler vectorises, with the square
-    // roots and divisions of a row side by side.
-    // (simd::Pack: GCC does not vectorise std::sqrt itself without -fno-math-errno.)
+    // lane by lane, -ffp-contract=off), eight lanes at a time with the square roots and
+    // divisions side by side (simd::Pack: GCC does not vectorise std::sqrt in a plain loop
+    // without -fno-math-errno).
     template <std::size_t N>
     void centre_rays(int x0, int y, const std::array<Real, N>& times, std::array<Ray<Real>, N>& rays) const {
         using Lanes = simd::Pack<Real, 8>;

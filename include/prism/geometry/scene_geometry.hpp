@@ -432,11 +432,12 @@ public:
                     }
                     if (found != present && !direct_spheres_.empty())
                         intersect_direct_spheres_lanes<true>(group, nullptr, n, found);
-                    if (plane_blocks_.empty()) {  // no direct meshes (intersection_batches) and no planes
+                    // No direct meshes (intersection_batches): the planes, ray by ray, where there are any.
+                    if (plane_blocks_.empty()) {
                         blocked |= found << first;
                         continue;
                     }
-                    for (int i = 0; i < n; ++i)  // no direct meshes (intersection_batches): the planes
+                    for (int i = 0; i < n; ++i)
                         if (((found >> i) & 1) || occluded_by_planes(group[i])) blocked |= std::uint32_t(1) << (first + i);
                 }
             }

@@ -72,8 +72,8 @@ PointWithError<Real> triangle_hit_point(const Vec3<double>& p0, const Vec3<doubl
 // vectors passed through memory cost hw1 simple_shading 2% of its instructions (GCC inlines it
 // or not as the shading code around it grows).
 template <Scalar Real, Scalar Vertex>
-[[gnu::always_inline]] inline PointWithError<Real> triangle_spawn_point(const Vec3<Vertex>& p0, const Vec3<Vertex>& p1, const Vec3<Vertex>& p2,
-                                          Real b1, Real b2) {
+[[gnu::always_inline]] inline PointWithError<Real> triangle_spawn_point(const Vec3<Vertex>& p0, const Vec3<Vertex>& p1,
+                                                                        const Vec3<Vertex>& p2, Real b1, Real b2) {
     PointWithError<Real> result = triangle_hit_point(p0, p1, p2, b1, b2);
     // In double for both precisions: R^3 overflows float for coordinates past ~1e12.
     const glm::dvec3 q0(p0), q1(p1), q2(p2), hit(result.point);

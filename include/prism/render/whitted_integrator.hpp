@@ -341,7 +341,6 @@ private:
             radiance[reflecting[std::size_t(j)]] += weights[std::size_t(j)] * traced[std::size_t(j)];
     }
 
-private:
     // `travelled`: the distance from the camera to the ray's origin along the path, which widens
     // the ray cone like a pinhole's (mirrors are treated as flat: Ray Tracing Gems ch. 20's
     // simplest variant).
@@ -384,8 +383,8 @@ private:
                                   travelled, origins);
     }
 
-    // shade, out of line: for radiance_row's deferred reflections, which inlining all of shade
-    // made too large for GCC to keep the row's own point and shading code inline.
+    // shade, out of line: for shade_row's reflections past row_depth, which inlining all of
+    // shade made too large for GCC to keep the row's own point and shading code inline.
     [[gnu::noinline]] Vec3<Real> shade_apart(const Ray<Real>& ray, const Hit<Real>& hit, int depth, CameraPath& path,
                                              Real travelled) const {
         return shade(ray, hit, depth, path, travelled);
@@ -461,7 +460,6 @@ private:
         if (environment_.present()) return environment_.radiance(direction);
         return depth == 0 ? background_ : Vec3<Real>(0);
     }
-
 
     // The ray leaving `point` along `direction`, as leaving_ray gives it, from the origin
     // `origins` holds for its side where rays leave by the error bound. spawn_origin depends on

@@ -26,12 +26,8 @@ constexpr std::uint64_t mix_bits(std::uint64_t v) {
 class Random {
 public:
     // `sequence` picks one of 2^63 independent streams, `seed` the starting point in it.
-    constexpr explicit Random(std::uint64_t seed = 0, std::uint64_t sequence = 0) {
-        increment_ = (sequence << 1u) | 1u;
-        next_u32();
-        state_ += mix_bits(seed);
-        next_u32();
-    }
+    constexpr explicit Random(std::uint64_t seed = 0, std::uint64_t sequence = 0)
+        : state_(seeded(sequence_increment(sequence), seed)), increment_(sequence_increment(sequence)) {}
 
     // The stream for pixel (x, y) of a render with the given seed.
     static constexpr Random for_pixel(int x, int y, std::uint64_t seed) {
@@ -53,17 +49,15 @@ public:
         for (std::size_t i = 0; i < N; ++i) {
             const std::uint64_t pixel =
                 (std::uint64_t(std::uint32_t(y)) << 32) | std::uint32_t(x0 + static_cast<int>(i));
-            increment[i] = (pixel << 1u) | 1u;
-            // The constructor: a step from state 0 (which leaves the increment), the seed
-            // added, a step; then the skipped steps as one.
-            const std::uint64_t seeded = (increment[i] + mix_bits(mix_bits(pixel ^ mixed_seed))) * multiplier + increment[i];
-            state[i] = seeded * jump.power + increment[i] * jump.sum;
+            increment[i] = sequence_increment(pixel);
+            // for_pixel's stream, then the skipped steps as one.
+            state[i] = seeded(increment[i], mix_bits(pixel ^ mixed_seed)) * jump.power + increment[i] * jump.sum;
         }
         if constexpr (sizeof(Real) == 4) {
             for (std::size_t i = 0; i < N; ++i) {
                 const std::uint64_t old = state[i];
                 state[i] = old * multiplier + increment[i];
-                draws[i] = Real(output(old) >> 8) * Real(0x1p-24);  // uniform<float>
+                draws[i] = unit_float(output(old));  // uniform<float>
             }
         }
         for (std::size_t i = 0; i < N; ++i) {
@@ -85,7 +79,7 @@ public:
     // after rounding to Real.
     template <Scalar Real>
     constexpr Real uniform() {
-        if constexpr (sizeof(Real) == 4) return Real(next_u32() >> 8) * Real(0x1p-24);
+        if constexpr (sizeof(Real) == 4) return unit_float(next_u32());
         else return Real((std::uint64_t(next_u32()) << 21) ^ (next_u32() >> 11)) * Real(0x1p-53);
     }
 
@@ -112,6 +106,17 @@ public:
 
 private:
     static constexpr std::uint64_t multiplier = 0x5851f42d4c957f2dULL;  // PCG's 64-bit LCG
+
+    static constexpr std::uint64_t sequence_increment(std::uint64_t sequence) { return (sequence << 1u) | 1u; }
+
+    // The state the constructor starts from: a step from state 0 (which leaves the increment),
+    // the mixed seed added, a step.
+    static constexpr std::uint64_t seeded(std::uint64_t increment, std::uint64_t seed) {
+        return (increment + mix_bits(seed)) * multiplier + increment;
+    }
+
+    // A float in [0, 1) from an output's top 24 bits.
+    static constexpr float unit_float(std::uint32_t bits) { return float(bits >> 8) * 0x1p-24f; }
 
     // PCG's XSH RR output of the state before a step.
     static constexpr std::uint32_t output(std::uint64_t old) {
