@@ -231,6 +231,108 @@ public:
         return traverse<true>(ray, t_min, t_max, leaf, touch);
     }
 
+    // Any hit for several rays at once (bit i of `lanes` for ray i, i < 32: a row's shadow rays
+    // to one light), each ray's answer traverse_any's: a ray is tested at a node only if it
+    // entered that node's box, with its own slab set-up (`slabs[i]`) and the node test
+    // traverse_any makes, so each ray reaches exactly the leaves it would reach alone. Only the
+    // order of the visits differs, which an any-hit answer does not depend on.
+    // leaf(first, count, lanes) tests the leaf's primitives for the rays of `lanes` and returns
+    // the blocked ones; the answer is every blocked ray.
+    // The rays' node tests are independent of each other: where one ray waits on each node's
+    // test before it can load the next node, the tests of the rays that reach a node overlap.
+    template <class Leaf>
+    std::uint32_t traverse_any_lanes(const TraversalRay* slabs, const Real* t_min, const Real* t_max, std::uint32_t lanes,
+                                     Leaf&& leaf) const {
+        if (nodes_.empty() || lanes == 0) return 0;
+        struct LaneEntry {
+            std::uint64_t child;
+            std::uint32_t lanes;
+        };
+        std::array<LaneEntry, stack_size> stack;
+        alignas(64) Real far_limit[32];
+        for (std::uint32_t rest = lanes; rest != 0; rest &= rest - 1) {
+            const int i = std::countr_zero(rest);
+            far_limit[i] = t_max[i] * far_scale;
+        }
+        int size = 0;
+        std::uint32_t blocked = 0;
+        std::uint64_t current = 0;
+        std::uint32_t current_lanes = lanes;
+        for (;;) {
+            const Node& node = node_at(current);
+            // Which rays enter each child: the rays' hit masks are the rows of a bit matrix
+            // (byte i % 8 of rows[i / 8] for ray i), transposed eight by eight into the
+            // children's ray masks, with no branch on any ray's hits (a loop over each ray's
+            // hit bits mispredicted at about every node).
+            std::array<std::uint64_t, 4> rows{};
+            for (std::uint32_t rest = current_lanes; rest != 0; rest &= rest - 1) {
+                const int i = std::countr_zero(rest);
+                Pack entry;
+                const std::uint64_t hits = enter(node, slabs[i], t_min[i], far_limit[i], entry).bits();
+                rows[std::size_t(i >> 3)] |= hits << (8 * (i & 7));
+            }
+            std::array<std::uint32_t, N> entering{};
+            for (int group = 0; group < 4; ++group) {
+                if (rows[std::size_t(group)] == 0) continue;
+                const std::uint64_t columns = transpose_bits(rows[std::size_t(group)]);
+                for (int c = 0; c < N; ++c)
+                    entering[std::size_t(c)] |= std::uint32_t((columns >> (8 * c)) & 0xff) << (8 * group);
+            }
+            // The leaves first, as traverse_any tests them: a shadow ray ends at its first blocker.
+            std::uint32_t inner = 0;
+            for (int c = 0; c < N; ++c) {
+                if (entering[std::size_t(c)] == 0) continue;
+                const std::uint64_t word = node.child[c];
+                if (!Node::is_leaf_word(word)) {
+                    inner |= std::uint32_t(1) << c;
+                    continue;
+                }
+                const std::uint32_t testing = entering[std::size_t(c)] & ~blocked;
+                if (testing == 0) continue;
+                PRISM_COUNT_LEAF(Node::leaf_count(word), N);
+                blocked |= leaf(Node::leaf_first(word), Node::leaf_count(word), testing) & testing;
+            }
+            if (blocked == lanes) return blocked;
+            bool descend = false;
+            if (inner != 0) {
+                const int last = 31 - std::countl_zero(inner);
+                inner &= ~(std::uint32_t(1) << last);
+                for (; inner != 0; inner &= inner - 1) {
+                    const int c = std::countr_zero(inner);
+                    stack[size++] = LaneEntry{node.child[c], entering[std::size_t(c)]};
+                    simd::prefetch(node_at(node.child[c]));
+                }
+                const std::uint32_t next = entering[std::size_t(last)] & ~blocked;
+                if (next != 0) {
+                    current = node.child[last];
+                    current_lanes = next;
+                    descend = true;
+                }
+            }
+            while (!descend && size > 0) {
+                const LaneEntry& entry = stack[--size];
+                const std::uint32_t next = entry.lanes & ~blocked;
+                if (next == 0) continue;
+                current = entry.child;
+                current_lanes = next;
+                descend = true;
+            }
+            if (!descend) return blocked;
+        }
+    }
+
+    // The 8x8 bit matrix whose row i is byte i of x, transposed (bit c of byte i becomes bit i
+    // of byte c): three exchanges of 2x2 blocks of growing size (Warren, Hacker's Delight 7-3).
+    static constexpr std::uint64_t transpose_bits(std::uint64_t x) {
+        std::uint64_t t = (x ^ (x >> 7)) & 0x00AA00AA00AA00AAull;
+        x ^= t ^ (t << 7);
+        t = (x ^ (x >> 14)) & 0x0000CCCC0000CCCCull;
+        x ^= t ^ (t << 14);
+        t = (x ^ (x >> 28)) & 0x00000000F0F0F0F0ull;
+        x ^= t ^ (t << 28);
+        return x;
+    }
+
     // Whether the ray enters any of the root's children within [t_min, t_max]: the first test
     // traversal makes, and the one a two-level scene makes before it prepares the triangle
     // test's set-up for the tree (geometry/scene_geometry.hpp). With the traversal ray's

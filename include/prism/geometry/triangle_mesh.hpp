@@ -283,6 +283,25 @@ public:
         });
     }
 
+    // occluded for the rays of `lanes` at once (bit i: rays[i], set up as traversal[i] and
+    // triangle[i]), each up to its own t_max: the blocked ones, each answered as occluded
+    // answers it (WideBvhTree::traverse_any_lanes; the leaf's packet test of each ray).
+    std::uint32_t occluded_lanes(const Ray<Real>* rays, const TraversalRay* traversal, const TriangleRay* triangle,
+                                 const Real* t_min, const Real* t_max, std::uint32_t lanes) const
+        requires packed
+    {
+        return index_.traverse_any_lanes(traversal, t_min, t_max, lanes,
+                                         [&](std::uint32_t first, std::uint32_t count, std::uint32_t testing) {
+                                             std::uint32_t blocked = 0;
+                                             for (; testing != 0; testing &= testing - 1) {
+                                                 const int i = std::countr_zero(testing);
+                                                 if (packets_.occluded(triangle[i].packed_ray, first, count, rays[i].t_min, t_max[i]))
+                                                     blocked |= std::uint32_t(1) << i;
+                                             }
+                                             return blocked;
+                                         });
+    }
+
     // Object-space normals and texture coordinates at a hit.
     // The hit point computed from the barycentrics, with the error bound a leaving ray must
     // clear (geometry/surface_error.hpp), in object space and the precision the triangle is

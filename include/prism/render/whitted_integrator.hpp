@@ -156,7 +156,7 @@ public:
     // radiance's own intersection finds, each ray's t_max lowered as it lowers it), then each
     // ray's radiance from its hit (radiance_at), the rest of radiance's work.
     bool batches_camera_rays() const {
-        if constexpr (requires { geometry_.intersection_batches(); }) return geometry_.intersection_batches();
+        if constexpr (requires { geometry_.intersection_batches(); }) return true;
         else return false;
     }
     std::uint32_t camera_hits(Ray<Real>* rays, Hit<Real>* hits, int count) const
