@@ -216,11 +216,19 @@ private:
         std::optional<RayBoxPrecomputed<Real>> box_ray;  // made once, for the first group's box
         for (const WorldMeshes& group : world_meshes_) {
             const Mesh& index = index_of(group);
-            if (!enters(index, ray, traversal_ray, box_ray)) continue;
-            if (!world_triangle_ray) world_triangle_ray.emplace(ray);
             const bool cull = culls_back_faces(Culling, group.smooth);
-            const bool group_hit = cull ? index.template intersect<true>(ray, traversal_ray, *world_triangle_ray, ray.t_max, hit)
-                                        : index.template intersect<false>(ray, traversal_ray, *world_triangle_ray, ray.t_max, hit);
+            bool group_hit = false;
+            if (group.leaves) {
+                if constexpr (Mesh::packed) {
+                    group_hit = cull ? intersect_root_leaves<true, true>(index, *group.leaves, ray, world_triangle_ray, hit)
+                                     : intersect_root_leaves<false, true>(index, *group.leaves, ray, world_triangle_ray, hit);
+                }
+            } else {
+                if (!enters(index, ray, traversal_ray, box_ray)) continue;
+                if (!world_triangle_ray) world_triangle_ray.emplace(ray);
+                group_hit = cull ? index.template intersect<true>(ray, traversal_ray, *world_triangle_ray, ray.t_max, hit)
+                                 : index.template intersect<false>(ray, traversal_ray, *world_triangle_ray, ray.t_max, hit);
+            }
             if (group_hit) {
                 if (group.index) group.attribute(index.source_triangle(hit.primitive), hit);
                 else hit.object = group.objects[0];
@@ -1321,12 +1329,15 @@ private:
     // hits are the index's: traversal of a single leaf tests that leaf, in the same slot order
     // with the same t_max; only a ray whose box test the index would fail is now tested too,
     // and the conservative box (Ize's widened exit) fails only rays that miss the triangles.
+    // A scene with a top-level index keeps it, and its TraversalRay, but its world-space
+    // indices of one or two leaves are still tested leaf by leaf (intersect_indexed): hw2
+    // horse_instanced's two-triangle floor had cost each camera ray a root test and a
+    // traversal of their own, 7% of its instructions.
     void choose_direct_world_meshes() {
+        for (WorldMeshes& group : world_meshes_) group.leaves = index_of(group).root_leaves();
         if (!top_objects_.empty() && !direct_top_) return;
         bool two_leaves = false;
-        for (WorldMeshes& group : world_meshes_) {
-            const Mesh& index = index_of(group);
-            group.leaves = index.root_leaves();
+        for (const WorldMeshes& group : world_meshes_) {
             if (!group.leaves) return;
             two_leaves |= group.leaves->count == 2;
         }
