@@ -15,6 +15,7 @@
 #include <prism/material/fresnel.hpp>
 #include <prism/material/material.hpp>
 #include <prism/memory/unconstructed.hpp>
+#include <prism/simd/pack.hpp>
 #include <prism/render/integrator.hpp>
 #include <prism/render/stored_whole.hpp>
 #include <prism/sampling/random.hpp>
@@ -230,6 +231,10 @@ private:
         std::array<std::array<Vec3<Real>, row_width>, row_lights> directions, radiances;
         std::array<std::array<Real, row_width>, row_lights> cosines;
         std::array<Unconstructed<Ray<Real>, row_width>, row_lights> shadows;  // per light, per ray
+        // Where rays leave by the scene's epsilon, the lights' samples and shadow rays are made
+        // lane by lane, a point in each (light_lanes), from the points gathered here.
+        const bool lanes_lit = settings_.ray_offset != RayOffset::error_bound;
+        RowPoints row{};
         for (int i = 0; i < count; ++i) {
             CameraPath& path = paths[i];
             if (!((found >> i) & 1)) {
@@ -248,6 +253,17 @@ private:
             at.color = geometry_.emitted(hits[i].object) + material.ambient * ambient_light_;
             // direct_lighting's samples and shadow rays (point_lighting_batched's, light by light).
             const Vec3<Real>& position = at.point.position;
+            if (lanes_lit) {
+                // Made below, light by light across the row (light_lanes); the draws now.
+                for (std::size_t k = 0; k < lights.size(); ++k) path.random.template skip<Real>(2);
+                for (int axis = 0; axis < 3; ++axis) {
+                    row.position[axis][i] = position[axis];
+                    row.normal[axis][i] = at.normal[axis];
+                }
+                row.time[i] = at.point.time;
+                row.shading |= std::uint32_t(1) << i;
+                continue;
+            }
             const ShadingFrame<Real> frame{position, at.normal};
             for (std::size_t k = 0; k < lights.size(); ++k) {
                 path.random.template skip<Real>(2);
@@ -258,6 +274,13 @@ private:
                 if (cosines[k][std::size_t(i)] <= 0) continue;
                 make_shadow_ray(shadows[k].make(std::size_t(i)), at.point, at.normal, sample, at.origins);
                 at.lit |= std::uint32_t(1) << k;
+            }
+        }
+        if (row.shading != 0) {
+            for (std::size_t k = 0; k < lights.size(); ++k) {
+                const std::uint32_t lit = light_lanes(lights[k], row, directions[k], radiances[k], cosines[k], shadows[k]);
+                for (std::uint32_t rest = lit; rest != 0; rest &= rest - 1)
+                    points[std::size_t(std::countr_zero(rest))].lit |= std::uint32_t(1) << k;
             }
         }
         // Each light's shadow rays across the row, side by side.
@@ -339,6 +362,88 @@ private:
         }
         for (int j = 0; j < reflected_count; ++j)
             radiance[reflecting[std::size_t(j)]] += weights[std::size_t(j)] * traced[std::size_t(j)];
+    }
+
+    // The shading points of a row, SoA, for light_lanes: bit i of `shading` for point i.
+    struct RowPoints {
+        alignas(64) Real position[3][row_width];
+        alignas(64) Real normal[3][row_width];
+        Real time[row_width];
+        std::uint32_t shading = 0;
+    };
+
+    // One point light's samples and shadow rays for the row's points, made as shade_row's
+    // loop makes them point by point (PointLight::sample, then make_shadow_ray by the scene's
+    // epsilon), with each lane computing the scalar code's operations in its order: the same
+    // directions, radiances, cosines and rays, bit for bit. A point and its lit lanes as the
+    // loop's `cos > 0` test (not `<= 0`) lights them; returns those lanes, whose rays are made.
+    // The square roots and divisions of sixteen points then share vector instructions.
+    std::uint32_t light_lanes(const PointLight<Real>& light, const RowPoints& row, std::array<Vec3<Real>, row_width>& directions,
+                              std::array<Vec3<Real>, row_width>& radiances, std::array<Real, row_width>& cosines,
+                              Unconstructed<Ray<Real>, row_width>& shadows) const {
+        constexpr int width = sizeof(Real) == 4 ? 16 : 8;
+        static_assert(row_width % width == 0);
+        using Lanes = simd::Pack<Real, width>;
+        std::uint32_t lit = 0;
+        for (int first = 0; first < row_width; first += width) {
+            const std::uint32_t shading = (row.shading >> first) & ((std::uint32_t(1) << width) - 1);
+            if (shading == 0) continue;
+            Lanes p[3], n[3], to_light[3];
+            for (int axis = 0; axis < 3; ++axis) {
+                p[axis] = Lanes::load(row.position[axis] + first);
+                n[axis] = Lanes::load(row.normal[axis] + first);
+                to_light[axis] = Lanes::broadcast(light.position[axis]) - p[axis];
+            }
+            // PointLight::sample: glm's dot sums (x + y) + z.
+            const Lanes distance_squared = (to_light[0] * to_light[0] + to_light[1] * to_light[1]) + to_light[2] * to_light[2];
+            const Lanes distance = simd::sqrt(distance_squared);
+            Lanes direction[3], radiance[3];
+            for (int axis = 0; axis < 3; ++axis) {
+                direction[axis] = to_light[axis] / distance;
+                radiance[axis] = Lanes::broadcast(light.intensity[axis]) / distance_squared;
+            }
+            const Lanes cosine = (n[0] * direction[0] + n[1] * direction[1]) + n[2] * direction[2];
+            // leaving_ray: the origin on the side dot(direction, normal) >= 0 names (the same
+            // products as the cosine's, so the same sum).
+            const auto towards = cosine >= Lanes::broadcast(Real(0));
+            const Lanes epsilon = Lanes::broadcast(epsilon_);
+            Lanes origin[3], aim[3];
+            for (int axis = 0; axis < 3; ++axis) {
+                origin[axis] = p[axis] + select(towards, n[axis], -n[axis]) * epsilon;
+                aim[axis] = (p[axis] + direction[axis] * distance) - origin[axis];
+            }
+            // unit_vector: v * (1 / sqrt(dot(v, v))); a light at infinity keeps the sample's direction.
+            const Lanes inverse_length =
+                Lanes::broadcast(Real(1)) / simd::sqrt((aim[0] * aim[0] + aim[1] * aim[1]) + aim[2] * aim[2]);
+            const auto finite = distance != Lanes::broadcast(infinity<Real>);
+            alignas(64) Real stored[13][width];
+            for (int axis = 0; axis < 3; ++axis) {
+                direction[axis].store(stored[axis]);
+                radiance[axis].store(stored[3 + axis]);
+                origin[axis].store(stored[6 + axis]);
+                select(finite, aim[axis] * inverse_length, direction[axis]).store(stored[9 + axis]);
+            }
+            cosine.store(stored[12]);
+            alignas(64) Real distances[width];
+            distance.store(distances);
+            const std::uint32_t lanes_lit = shading & (!(cosine <= Lanes::broadcast(Real(0)))).bits();
+            for (std::uint32_t rest = shading; rest != 0; rest &= rest - 1) {
+                const int lane = std::countr_zero(rest);
+                const std::size_t i = std::size_t(first + lane);
+                directions[i] = Vec3<Real>(stored[0][lane], stored[1][lane], stored[2][lane]);
+                radiances[i] = Vec3<Real>(stored[3][lane], stored[4][lane], stored[5][lane]);
+                cosines[i] = stored[12][lane];
+                if (!((lanes_lit >> lane) & 1)) continue;
+                Ray<Real>& made = shadows.make(i);
+                made.origin = Vec3<Real>(stored[6][lane], stored[7][lane], stored[8][lane]);
+                made.direction = Vec3<Real>(stored[9][lane], stored[10][lane], stored[11][lane]);
+                made.t_min = Real(0);
+                made.t_max = distances[lane];
+                made.time = row.time[i];
+            }
+            lit |= lanes_lit << first;
+        }
+        return lit;
     }
 
     // `travelled`: the distance from the camera to the ray's origin along the path, which widens
