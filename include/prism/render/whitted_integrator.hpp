@@ -231,9 +231,8 @@ private:
         std::array<std::array<Vec3<Real>, row_width>, row_lights> directions, radiances;
         std::array<std::array<Real, row_width>, row_lights> cosines;
         std::array<Unconstructed<Ray<Real>, row_width>, row_lights> shadows;  // per light, per ray
-        // Where rays leave by the scene's epsilon, the lights' samples and shadow rays are made
-        // lane by lane, a point in each (light_lanes), from the points gathered here.
-        const bool lanes_lit = settings_.ray_offset != RayOffset::error_bound;
+        // The lights' samples and shadow rays are made lane by lane, a point in each
+        // (light_lanes), from the points gathered here.
         RowPoints row{};
         for (int i = 0; i < count; ++i) {
             CameraPath& path = paths[i];
@@ -253,32 +252,23 @@ private:
             at.color = geometry_.emitted(hits[i].object) + material.ambient * ambient_light_;
             // direct_lighting's samples and shadow rays (point_lighting_batched's, light by light).
             const Vec3<Real>& position = at.point.position;
-            if (lanes_lit) {
-                // Made below, light by light across the row (light_lanes); the draws now.
-                for (std::size_t k = 0; k < lights.size(); ++k) path.random.template skip<Real>(2);
-                for (int axis = 0; axis < 3; ++axis) {
-                    row.position[axis][i] = position[axis];
-                    row.normal[axis][i] = at.normal[axis];
-                }
-                row.time[i] = at.point.time;
-                row.shading |= std::uint32_t(1) << i;
-                continue;
+            // Made below, light by light across the row (light_lanes); the draws now.
+            for (std::size_t k = 0; k < lights.size(); ++k) path.random.template skip<Real>(2);
+            for (int axis = 0; axis < 3; ++axis) {
+                row.position[axis][i] = position[axis];
+                row.normal[axis][i] = at.normal[axis];
             }
-            const ShadingFrame<Real> frame{position, at.normal};
-            for (std::size_t k = 0; k < lights.size(); ++k) {
-                path.random.template skip<Real>(2);
-                const LightSample<Real> sample = lights[k].sample(frame);
-                directions[k][std::size_t(i)] = sample.direction;
-                radiances[k][std::size_t(i)] = sample.radiance;
-                cosines[k][std::size_t(i)] = glm::dot(at.normal, sample.direction);
-                if (cosines[k][std::size_t(i)] <= 0) continue;
-                make_shadow_ray(shadows[k].make(std::size_t(i)), at.point, at.normal, sample, at.origins);
-                at.lit |= std::uint32_t(1) << k;
-            }
+            row.time[i] = at.point.time;
+            row.shading |= std::uint32_t(1) << i;
         }
         if (row.shading != 0) {
+            const auto origin_of = [&](std::size_t i, const Vec3<Real>& direction) {
+                RowPoint& at = points[i];
+                return leaving(at.point, at.normal, direction, at.point.time, at.origins).origin;
+            };
             for (std::size_t k = 0; k < lights.size(); ++k) {
-                const std::uint32_t lit = light_lanes(lights[k], row, directions[k], radiances[k], cosines[k], shadows[k]);
+                const std::uint32_t lit =
+                    light_lanes(lights[k], row, directions[k], radiances[k], cosines[k], shadows[k], origin_of);
                 for (std::uint32_t rest = lit; rest != 0; rest &= rest - 1)
                     points[std::size_t(std::countr_zero(rest))].lit |= std::uint32_t(1) << k;
             }
@@ -372,15 +362,20 @@ private:
         std::uint32_t shading = 0;
     };
 
-    // One point light's samples and shadow rays for the row's points, made as shade_row's
-    // loop makes them point by point (PointLight::sample, then make_shadow_ray by the scene's
-    // epsilon), with each lane computing the scalar code's operations in its order: the same
-    // directions, radiances, cosines and rays, bit for bit. A point and its lit lanes as the
-    // loop's `cos > 0` test (not `<= 0`) lights them; returns those lanes, whose rays are made.
-    // The square roots and divisions of sixteen points then share vector instructions.
+    // One point light's samples and shadow rays for the row's points, made as direct_lighting
+    // makes them point by point (PointLight::sample, then make_shadow_ray), with each lane
+    // computing the scalar code's operations in its order: the same directions, radiances,
+    // cosines and rays, bit for bit. The lit lanes are those the scalar `cos <= 0` test lets
+    // through (NaN included); returns them, whose rays are made. The square roots and
+    // divisions of sixteen points then share vector instructions (hw2 mirror_room: 0.88 of
+    // the wall time with the rays made point by point).
+    // `origin_of(i, direction)`: point i's shadow-ray origin where rays leave by their error
+    // bounds (leaving's, made lane by lane in the lit lanes' order); by the scene's epsilon the
+    // origins are made here, lane by lane as leaving_ray makes them.
+    template <class OriginOf>
     std::uint32_t light_lanes(const PointLight<Real>& light, const RowPoints& row, std::array<Vec3<Real>, row_width>& directions,
                               std::array<Vec3<Real>, row_width>& radiances, std::array<Real, row_width>& cosines,
-                              Unconstructed<Ray<Real>, row_width>& shadows) const {
+                              Unconstructed<Ray<Real>, row_width>& shadows, OriginOf origin_of) const {
         constexpr int width = sizeof(Real) == 4 ? 16 : 8;
         static_assert(row_width % width == 0);
         using Lanes = simd::Pack<Real, width>;
@@ -403,15 +398,25 @@ private:
                 radiance[axis] = Lanes::broadcast(light.intensity[axis]) / distance_squared;
             }
             const Lanes cosine = (n[0] * direction[0] + n[1] * direction[1]) + n[2] * direction[2];
-            // leaving_ray: the origin on the side dot(direction, normal) >= 0 names (the same
-            // products as the cosine's, so the same sum).
-            const auto towards = cosine >= Lanes::broadcast(Real(0));
-            const Lanes epsilon = Lanes::broadcast(epsilon_);
+            const std::uint32_t lanes_lit = shading & (!(cosine <= Lanes::broadcast(Real(0)))).bits();
             Lanes origin[3], aim[3];
-            for (int axis = 0; axis < 3; ++axis) {
-                origin[axis] = p[axis] + select(towards, n[axis], -n[axis]) * epsilon;
-                aim[axis] = (p[axis] + direction[axis] * distance) - origin[axis];
+            if (settings_.ray_offset != RayOffset::error_bound) {
+                // leaving_ray: the origin on the side dot(direction, normal) >= 0 names (the same
+                // products as the cosine's, so the same sum).
+                const auto towards = cosine >= Lanes::broadcast(Real(0));
+                const Lanes epsilon = Lanes::broadcast(epsilon_);
+                for (int axis = 0; axis < 3; ++axis) origin[axis] = p[axis] + select(towards, n[axis], -n[axis]) * epsilon;
+            } else {
+                alignas(64) Real aimed[3][width], origins[3][width] = {};
+                for (int axis = 0; axis < 3; ++axis) direction[axis].store(aimed[axis]);
+                for (std::uint32_t rest = lanes_lit; rest != 0; rest &= rest - 1) {
+                    const int lane = std::countr_zero(rest);
+                    const Vec3<Real> made = origin_of(std::size_t(first + lane), Vec3<Real>(aimed[0][lane], aimed[1][lane], aimed[2][lane]));
+                    for (int axis = 0; axis < 3; ++axis) origins[axis][lane] = made[axis];
+                }
+                for (int axis = 0; axis < 3; ++axis) origin[axis] = Lanes::load(origins[axis]);
             }
+            for (int axis = 0; axis < 3; ++axis) aim[axis] = (p[axis] + direction[axis] * distance) - origin[axis];
             // unit_vector: v * (1 / sqrt(dot(v, v))); a light at infinity keeps the sample's direction.
             const Lanes inverse_length =
                 Lanes::broadcast(Real(1)) / simd::sqrt((aim[0] * aim[0] + aim[1] * aim[1]) + aim[2] * aim[2]);
@@ -426,7 +431,6 @@ private:
             cosine.store(stored[12]);
             alignas(64) Real distances[width];
             distance.store(distances);
-            const std::uint32_t lanes_lit = shading & (!(cosine <= Lanes::broadcast(Real(0)))).bits();
             for (std::uint32_t rest = shading; rest != 0; rest &= rest - 1) {
                 const int lane = std::countr_zero(rest);
                 const std::size_t i = std::size_t(first + lane);
