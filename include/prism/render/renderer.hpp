@@ -149,9 +149,9 @@ private:
                         lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time));
                 }
             }
-            // Where the geometry tests rays side by side (SceneGeometry::intersection_batches),
-            // the row's closest hits first, then its shading: the row's shadow rays side by side
-            // too where the integrator can (radiance_row), else ray by ray from each hit.
+            // Where the integrator can (batches_camera_rays), the row's closest hits first, then
+            // its shading: the row's shadow rays side by side too where it can (radiance_row),
+            // else ray by ray from each hit.
             if constexpr (requires { integrator_.camera_hits(rays.data(), (Hit<Real>*)nullptr, n); }) {
                 if (integrator_.batches_camera_rays()) {
                     std::array<Hit<Real>, batch> hits;

@@ -152,10 +152,12 @@ public:
     // Radiance arriving along a camera ray with a unit direction.
     Vec3<Real> radiance(const Ray<Real>& ray, CameraPath& path) const { return trace(ray, 0, path, Real(0)); }
 
-    // Camera rays several at a time, where the geometry tests them side by side
-    // (SceneGeometry::intersection_batches): first their closest hits (camera_hits, the hits
-    // radiance's own intersection finds, each ray's t_max lowered as it lowers it), then each
-    // ray's radiance from its hit (radiance_at), the rest of radiance's work.
+    // Camera rays several at a time, under prism's own geometry (SceneGeometry): first their
+    // closest hits (camera_hits, the hits radiance's own intersection finds, each ray's t_max
+    // lowered as it lowers it; side by side where SceneGeometry::intersection_batches, else one
+    // by one), then each ray's radiance from its hit (radiance_at), the rest of radiance's
+    // work. Index scenes gain from the rows too: their shadow rays go side by side through
+    // the index (hw2 horse_instanced: 0.96 of the CPU time with rows, before that).
     bool batches_camera_rays() const {
         if constexpr (requires { geometry_.intersection_batches(); }) return true;
         else return false;
