@@ -252,9 +252,9 @@ private:
             at.inside_medium = !at.front_face && material.type == scene::MaterialType::dielectric;
             if (at.inside_medium) continue;
             at.color = geometry_.emitted(hits[i].object) + material.ambient * ambient_light_;
-            // direct_lighting's samples and shadow rays (point_lighting_batched's, light by light).
+            // direct_lighting's samples and shadow rays are made below, light by light across
+            // the row (light_lanes); the stream steps past their draws now, in the same order.
             const Vec3<Real>& position = at.point.position;
-            // Made below, light by light across the row (light_lanes); the draws now.
             for (std::size_t k = 0; k < lights.size(); ++k) path.random.template skip<Real>(2);
             for (int axis = 0; axis < 3; ++axis) {
                 row.position[axis][i] = position[axis];
@@ -401,6 +401,10 @@ private:
             }
             const Lanes cosine = (n[0] * direction[0] + n[1] * direction[1]) + n[2] * direction[2];
             const std::uint32_t lanes_lit = shading & (!(cosine <= Lanes::broadcast(Real(0)))).bits();
+            // Rows 0-2 the directions, 3-5 the radiances, 6-8 the origins, 9-11 the shadow rays'
+            // directions, 12 the cosines.
+            alignas(64) Real stored[13][width];
+            for (int axis = 0; axis < 3; ++axis) direction[axis].store(stored[axis]);
             Lanes origin[3], aim[3];
             if (settings_.ray_offset != RayOffset::error_bound) {
                 // leaving_ray: the origin on the side dot(direction, normal) >= 0 names (the same
@@ -409,11 +413,11 @@ private:
                 const Lanes epsilon = Lanes::broadcast(epsilon_);
                 for (int axis = 0; axis < 3; ++axis) origin[axis] = p[axis] + select(towards, n[axis], -n[axis]) * epsilon;
             } else {
-                alignas(64) Real aimed[3][width], origins[3][width] = {};
-                for (int axis = 0; axis < 3; ++axis) direction[axis].store(aimed[axis]);
+                alignas(64) Real origins[3][width] = {};
                 for (std::uint32_t rest = lanes_lit; rest != 0; rest &= rest - 1) {
                     const int lane = std::countr_zero(rest);
-                    const Vec3<Real> made = origin_of(std::size_t(first + lane), Vec3<Real>(aimed[0][lane], aimed[1][lane], aimed[2][lane]));
+                    const Vec3<Real> made =
+                        origin_of(std::size_t(first + lane), Vec3<Real>(stored[0][lane], stored[1][lane], stored[2][lane]));
                     for (int axis = 0; axis < 3; ++axis) origins[axis][lane] = made[axis];
                 }
                 for (int axis = 0; axis < 3; ++axis) origin[axis] = Lanes::load(origins[axis]);
@@ -423,9 +427,7 @@ private:
             const Lanes inverse_length =
                 Lanes::broadcast(Real(1)) / simd::sqrt((aim[0] * aim[0] + aim[1] * aim[1]) + aim[2] * aim[2]);
             const auto finite = distance != Lanes::broadcast(infinity<Real>);
-            alignas(64) Real stored[13][width];
             for (int axis = 0; axis < 3; ++axis) {
-                direction[axis].store(stored[axis]);
                 radiance[axis].store(stored[3 + axis]);
                 origin[axis].store(stored[6 + axis]);
                 select(finite, aim[axis] * inverse_length, direction[axis]).store(stored[9 + axis]);
