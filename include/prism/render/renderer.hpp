@@ -231,6 +231,27 @@ private:
                     const int count = int(std::min(batch, n - first));
                     Ray<Real>* const rays = scratch.rays.data() + first;
                     const std::uint32_t found = integrator_.camera_hits(rays, hits.data(), count);
+                    // Where the integrator samples the lights that draw nothing for several
+                    // samples first (radiances_at), their shadow rays go side by side.
+                    if constexpr (requires(Vec3<Real>* radiance) {
+                                      integrator_.radiances_at(rays, hits.data(), found, count, path, radiance);
+                                  }) {
+                        if (integrator_.prelights()) {
+                            constexpr int width = Integrator::prelit_width;
+                            std::array<Vec3<Real>, width> radiance;
+                            for (int part = 0; part < count; part += width) {
+                                const int n = std::min(width, count - part);
+                                integrator_.radiances_at(rays + part, hits.data() + part, found >> part, n, path,
+                                                         radiance.data());
+                                for (int i = 0; i < n; ++i) {
+                                    const Real weight = scratch.weights[first + std::size_t(part + i)];
+                                    sum += weight * radiance[std::size_t(i)];
+                                    weights += weight;
+                                }
+                            }
+                            continue;
+                        }
+                    }
                     for (int i = 0; i < count; ++i) {
                         const Real weight = scratch.weights[first + std::size_t(i)];
                         sum += weight * integrator_.radiance_at(rays[i], hits[std::size_t(i)], (found >> i) & 1, path);

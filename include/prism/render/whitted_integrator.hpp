@@ -28,6 +28,7 @@
 #include <cmath>
 #include <optional>
 #include <type_traits>
+#include <variant>
 #include <vector>
 
 namespace prism {
@@ -140,7 +141,7 @@ public:
                       const Vec3<Real>& background, const IntegratorSettings& settings)
         : geometry_(geometry), lights_(lights), materials_(materials), textures_(textures), environment_(environment),
           ambient_light_(ambient_light), background_(background), settings_(settings),
-          epsilon_(Real(settings.shadow_ray_epsilon)) {}
+          epsilon_(Real(settings.shadow_ray_epsilon)), prelit_count_(count_prelit(lights)) {}
 
     // What a camera ray carries down its recursion besides the ray itself.
     struct CameraPath {
@@ -205,7 +206,168 @@ public:
         shade_row<true>(rays, hits, found, count, paths.data(), nullptr, 0, radiance);
     }
 
+    // radiance_at for `count` (<= prelit_width) camera rays of one pixel's samples, which
+    // draw from one stream (`path`), in their order: radiance[i] for rays[i]. Each sample's
+    // draws depend on every earlier sample's, but the lights that draw nothing (point,
+    // directional, spot: `sample(at)` alone) need no draw to be sampled: their shadow rays from
+    // the samples' camera hits are made first, up to prelit_lights such lights, and tested
+    // side by side light by light (SceneGeometry::occluded_side_by_side: the samples of a
+    // pixel meet nearly one point, so their rays reach the same nodes). Then each sample is
+    // shaded as shade shades it, its stream stepping past those lights' draws in their turn.
+    // The same rays, tests, draws and sums as radiance_at, so the same bits. Only where
+    // prelights(): the scene has such a light.
+    static constexpr int prelit_width = 16;
+    static_assert(prelit_width == row_width, "radiances_at makes point lights' rays as rows do (light_lanes)");
+    static constexpr std::size_t prelit_lights = 8;
+    bool prelights() const { return prelit_count_ > 0; }
+    void radiances_at(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count, CameraPath& path,
+                      Vec3<Real>* radiance) const
+        requires requires(const Geometry& geometry, const Ray<Real>* shadows) { geometry.occluded_side_by_side(shadows, 1); }
+    {
+        // shade's state at a camera hit up to its direct lighting (the point made in place).
+        struct PrelitPoint {
+            SurfacePoint<Real> point;
+            Vec3<Real> normal;
+            SpawnOrigins origins;
+            Real travelled;
+            std::uint32_t visible = 0;  // bit k: prelit light k's shadow ray is made and reaches it
+            bool front_face, inside_medium;
+        };
+        Unconstructed<PrelitPoint, prelit_width> points;
+        // Textures change a copy of the material; without them it is read where it is stored.
+        std::conditional_t<textured<Textures, Real>, Unconstructed<Material<Real>, prelit_width>, std::monostate> copies;
+        const auto material_of = [&](int i) -> decltype(auto) {
+            if constexpr (textured<Textures, Real>) return copies[std::size_t(i)];
+            else return static_cast<const Material<Real>&>(materials_[points[std::size_t(i)].point.material]);
+        };
+        std::uint32_t shading = 0;  // the samples shaded below (not escaped, not unshaded by a texture)
+        std::uint32_t lighting = 0;  // the shading samples lit directly (outside a medium)
+        for (int i = 0; i < count; ++i) {
+            if (!((found >> i) & 1)) {
+                radiance[i] = escaped(rays[i].direction, 0, path.pixel_uv);
+                continue;
+            }
+            const Ray<Real>& ray = rays[i];
+            PrelitPoint& at = points.make_from(std::size_t(i), [&] {
+                return PrelitPoint{shading_surface<textured<Textures, Real>>(geometry_, ray, hits[i], settings_.ray_offset)};
+            });
+            if constexpr (textured<Textures, Real>) copies.make(std::size_t(i), materials_[at.point.material]);
+            at.travelled = Real(0) + hits[i].t;
+            const RayCone<Real> cone{at.travelled * path.spread, std::abs(glm::dot(ray.direction, at.point.shading_normal))};
+            if (const std::optional<Vec3<Real>> unshaded = textures_.apply(at.point, material_of(i), cone)) {
+                radiance[i] = *unshaded;
+                continue;
+            }
+            at.front_face = glm::dot(at.point.geometric_normal, ray.direction) < 0;
+            at.normal = at.front_face ? at.point.shading_normal : -at.point.shading_normal;
+            at.inside_medium = !at.front_face && material_of(i).type == scene::MaterialType::dielectric;
+            shading |= std::uint32_t(1) << i;
+            if (!at.inside_medium) lighting |= std::uint32_t(1) << i;
+        }
+        // Each prelit light's samples and shadow rays across the samples, the rays side by side.
+        std::array<std::array<Vec3<Real>, prelit_width>, prelit_lights> directions, radiances;
+        std::array<std::array<Real, prelit_width>, prelit_lights> cosines;
+        std::size_t k = 0;
+        std::optional<RowPoints> row;  // the lighting points SoA, for the first point light
+        const auto origin_of = [&](std::size_t i, const Vec3<Real>& direction) {
+            PrelitPoint& at = points[i];
+            return leaving(at.point, at.normal, direction, at.point.time, at.origins).origin;
+        };
+        lights_.for_each([&](const auto& light) {
+            if constexpr (draws_nothing<std::decay_t<decltype(light)>>) {
+                if (k == prelit_lights || lighting == 0) return;
+                const std::size_t j = k++;
+                Unconstructed<Ray<Real>, prelit_width> shadows;
+                std::array<int, prelit_width> owner;
+                int n = 0;
+                if constexpr (std::is_same_v<std::decay_t<decltype(light)>, PointLight<Real>>) {
+                    // Point lights lane by lane, as shade_row makes them (light_lanes).
+                    if (!row) {
+                        row.emplace();
+                        for (std::uint32_t rest = lighting; rest != 0; rest &= rest - 1) {
+                            const int i = std::countr_zero(rest);
+                            const PrelitPoint& at = points[std::size_t(i)];
+                            for (int axis = 0; axis < 3; ++axis) {
+                                row->position[axis][i] = at.point.position[axis];
+                                row->normal[axis][i] = at.normal[axis];
+                            }
+                            row->time[i] = at.point.time;
+                        }
+                        row->shading = lighting;
+                    }
+                    Unconstructed<Ray<Real>, prelit_width> made;
+                    const std::uint32_t lit =
+                        light_lanes(light, *row, directions[j], radiances[j], cosines[j], made, origin_of);
+                    for (std::uint32_t rest = lit; rest != 0; rest &= rest - 1) {
+                        const int i = std::countr_zero(rest);
+                        shadows.make(std::size_t(n), made[std::size_t(i)]);
+                        owner[std::size_t(n++)] = i;
+                    }
+                } else {
+                  for (std::uint32_t rest = lighting; rest != 0; rest &= rest - 1) {
+                    const int i = std::countr_zero(rest);
+                    PrelitPoint& at = points[std::size_t(i)];
+                    const LightSample<Real> sample = light.sample(ShadingFrame<Real>{at.point.position, at.normal});
+                    directions[j][std::size_t(i)] = sample.direction;
+                    radiances[j][std::size_t(i)] = sample.radiance;
+                    cosines[j][std::size_t(i)] = glm::dot(at.normal, sample.direction);
+                    if (cosines[j][std::size_t(i)] <= 0) continue;
+                    make_shadow_ray(shadows.make(std::size_t(n)), at.point, at.normal, sample, at.origins);
+                    owner[std::size_t(n++)] = i;
+                  }
+                }
+                if (n == 0) return;
+                const std::uint32_t blocked = geometry_.occluded_side_by_side(shadows.data(), n);
+                for (int m = 0; m < n; ++m)
+                    if (!((blocked >> m) & 1)) points[std::size_t(owner[std::size_t(m)])].visible |= std::uint32_t(1) << j;
+            }
+        });
+        // Each sample shaded in its turn, as shade shades it.
+        for (std::uint32_t rest = shading; rest != 0; rest &= rest - 1) {
+            const int i = std::countr_zero(rest);
+            PrelitPoint& at = points[std::size_t(i)];
+            const Material<Real>& material = material_of(i);
+            Vec3<Real> color(0);
+            if (!at.inside_medium) {
+                color = geometry_.emitted(hits[i].object) + material.ambient * ambient_light_;
+                const Vec3<Real> to_viewer = -rays[i].direction;
+                Vec3<Real> direct(0);
+                std::size_t light_index = 0;  // among the prelit lights
+                lights_.for_each([&](const auto& light) {
+                    if constexpr (draws_nothing<std::decay_t<decltype(light)>>) {
+                        if (light_index < prelit_lights) {
+                            const std::size_t j = light_index++;
+                            path.random.template skip<Real>(2);
+                            if (!((at.visible >> j) & 1)) return;
+                            LightSample<Real> sample;
+                            sample.direction = directions[j][std::size_t(i)];
+                            sample.radiance = radiances[j][std::size_t(i)];
+                            direct += reflected(material, at.normal, to_viewer, sample, cosines[j][std::size_t(i)]);
+                            return;
+                        }
+                    }
+                    light_term(light, at.point, at.normal, to_viewer, material, path.random, at.origins, direct);
+                });
+                color += direct;
+            }
+            radiance[i] = reflect_and_absorb(rays[i], hits[i], at.point, material, at.normal, at.front_face,
+                                             at.inside_medium, color, 0, path, at.travelled, at.origins);
+        }
+    }
+
 private:
+    // The light types sampled without a draw (sample(at) alone).
+    template <class L>
+    static constexpr bool draws_nothing = requires(const L& light, const ShadingFrame<Real>& at) { light.sample(at); };
+
+    static std::size_t count_prelit(const LightSetT& lights) {
+        std::size_t count = 0;
+        lights.for_each([&](const auto& light) {
+            if constexpr (draws_nothing<std::decay_t<decltype(light)>>) ++count;
+        });
+        return std::min(count, prelit_lights);
+    }
+
     // How deep radiance_row follows a row's mirror and conductor reflections as rows (a
     // shade_row frame each, some 20 kB of a worker's stack); deeper ones are traced one by one.
     static constexpr int row_depth = 8;
@@ -603,42 +765,46 @@ private:
                 return point_lighting_batched(point, normal, to_viewer, material, random, origins, lights);
         }
         Vec3<Real> color(0);
-        const Vec3<Real>& position = point.position;
-        const auto shadow_ray = [&](const Vec3<Real>& direction) {
-            return leaving(point, normal, direction, point.time, origins);
-        };
-        lights_.for_each([&](const auto& light) {
-            // A light that takes no sample (point, directional, spot: sample(at) alone) gets none
-            // drawn, but the stream steps past its two numbers, so that every later draw is the
-            // one it was (the images stay the same).
-            const ShadingFrame<Real> at{position, normal};
-            const LightSample<Real> sample = [&] {
-                if constexpr (requires { light.sample(at); }) {
-                    random.template skip<Real>(2);
-                    return light.sample(at);
-                } else {
-                    return light.sample(at, random.uniform2<Real>());
-                }
-            }();
-            const Real cos_light = glm::dot(normal, sample.direction);
-            if (cos_light <= 0) return;
-            // The shadow ray leaves the offset origin aimed at the light, and anything nearer than
-            // the light's distance from the shading point blocks it. So a surface through the
-            // light itself blocks it for every point, not by rounding (mirror_room's ceiling
-            // holds a light: 20.3 dB with a per-pixel coin flip, 64.5 dB consistent).
-            Ray<Real> shadow = shadow_ray(sample.direction);
-            if (!std::isinf(sample.distance))
-                shadow.direction = unit_vector(position + sample.direction * sample.distance - shadow.origin);
-            shadow.t_max = sample.distance;
-            // An object light's own surface is at the far end and is geometry: stop short of it,
-            // as the path tracer does, or the light shadows itself (every point black, but for
-            // rounding). Area lights are no geometry, so their rule above stays.
-            if constexpr (std::decay_t<decltype(light)>::kind == scene::LightKind::object)
-                shadow.t_max = glm::length(position + sample.direction * sample.distance - shadow.origin) * (1 - Real(1e-4));
-            if (geometry_.occluded(shadow)) return;
-            color += reflected(material, normal, to_viewer, sample, cos_light);
-        });
+        lights_.for_each([&](const auto& light) { light_term(light, point, normal, to_viewer, material, random, origins, color); });
         return color;
+    }
+
+    // One light's term of direct_lighting's sum, added to `color` where its shadow ray is not
+    // blocked.
+    template <class L>
+    [[gnu::always_inline]] void light_term(const L& light, const SurfacePoint<Real>& point, const Vec3<Real>& normal,
+                                           const Vec3<Real>& to_viewer, const Material<Real>& material, Random& random,
+                                           SpawnOrigins& origins, Vec3<Real>& color) const {
+        const Vec3<Real>& position = point.position;
+        // A light that takes no sample (point, directional, spot: sample(at) alone) gets none
+        // drawn, but the stream steps past its two numbers, so that every later draw is the
+        // one it was (the images stay the same).
+        const ShadingFrame<Real> at{position, normal};
+        const LightSample<Real> sample = [&] {
+            if constexpr (draws_nothing<L>) {
+                random.template skip<Real>(2);
+                return light.sample(at);
+            } else {
+                return light.sample(at, random.uniform2<Real>());
+            }
+        }();
+        const Real cos_light = glm::dot(normal, sample.direction);
+        if (cos_light <= 0) return;
+        // The shadow ray leaves the offset origin aimed at the light, and anything nearer than
+        // the light's distance from the shading point blocks it. So a surface through the
+        // light itself blocks it for every point, not by rounding (mirror_room's ceiling
+        // holds a light: 20.3 dB with a per-pixel coin flip, 64.5 dB consistent).
+        Ray<Real> shadow = leaving(point, normal, sample.direction, point.time, origins);
+        if (!std::isinf(sample.distance))
+            shadow.direction = unit_vector(position + sample.direction * sample.distance - shadow.origin);
+        shadow.t_max = sample.distance;
+        // An object light's own surface is at the far end and is geometry: stop short of it,
+        // as the path tracer does, or the light shadows itself (every point black, but for
+        // rounding). Area lights are no geometry, so their rule above stays.
+        if constexpr (L::kind == scene::LightKind::object)
+            shadow.t_max = glm::length(position + sample.direction * sample.distance - shadow.origin) * (1 - Real(1e-4));
+        if (geometry_.occluded(shadow)) return;
+        color += reflected(material, normal, to_viewer, sample, cos_light);
     }
 
     // Several point lights' shadow rays made before the first is tested, and tested in one
@@ -758,6 +924,7 @@ private:
     Vec3<Real> background_;
     IntegratorSettings settings_;
     Real epsilon_;
+    std::size_t prelit_count_;  // the lights radiances_at samples first (count_prelit)
 };
 
 // The Config policy that renders with the course's recursive ray tracer.
