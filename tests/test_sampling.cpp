@@ -392,6 +392,151 @@ TEST_CASE_TEMPLATE("Renderer: a row's mirrors and conductors, their reflections 
     }
 }
 
+TEST_CASE_TEMPLATE("Renderer: a pixel's samples lit side by side (radiances_at) give the one-by-one trace's bits",
+                   Real, float, double) {
+    // Renderer::pixel hands a multi-sample pixel's camera hits to WhittedIntegrator::radiances_at,
+    // which makes the shadow rays to the lights that draw nothing (point, directional, spot) for
+    // every sample first and tests them side by side, then shades each sample in its turn from
+    // the pixel's one stream. The reference is the integrator's own recursive trace (radiance),
+    // sample after sample on that stream, summed with the filter weights as Renderer::pixel sums
+    // them: every draw (the area light's, the rough mirror's, the lens's) must fall where it
+    // fell, and every pixel's bits must agree. Textures (a checkerboard's replace_kd, an image's
+    // replace_all, which shades nothing), glass, a rough mirror and a conductor; 5, 16 and 40
+    // samples (radiances_at's chunks of 16, Renderer::pixel's batches of 32); both ray offsets;
+    // without and with an index (a transformed mesh joins the top level).
+    scene::Scene world;
+    scene::Camera camera = looking_down_z(14, 10);
+    camera.position = {0, 1.5, 10};
+    camera.aperture_size = 0.15;
+    camera.focus_distance = 9;
+    camera.filter = scene::PixelFilter::gaussian;
+    world.cameras.push_back(camera);
+    scene::Material floor_material = matte(0.6);
+    floor_material.specular = glm::dvec3(0.3);
+    floor_material.phong_exponent = 12;
+    scene::Material glass;
+    glass.type = scene::MaterialType::dielectric;
+    glass.refraction_index = 1.5;
+    glass.absorption_coefficient = glm::dvec3(0.2, 0.05, 0.1);
+    scene::Material rough_mirror = matte(0.1);
+    rough_mirror.type = scene::MaterialType::mirror;
+    rough_mirror.mirror = glm::dvec3(0.7);
+    rough_mirror.roughness = 0.2;
+    scene::Material conductor = matte(0.1);
+    conductor.type = scene::MaterialType::conductor;
+    conductor.mirror = glm::dvec3(0.9, 0.8, 0.6);
+    conductor.refraction_index = 0.37;
+    conductor.absorption_index = 2.8;
+    world.materials = {floor_material, glass, rough_mirror, conductor, matte(0.5)};
+    scene::Texture checker;
+    checker.kind = scene::TextureKind::checkerboard;
+    checker.decal_mode = scene::DecalMode::replace_kd;
+    checker.scale = 1.3;
+    checker.black_color = glm::dvec3(0.1, 0.2, 0.1);
+    checker.white_color = glm::dvec3(0.9, 0.8, 0.7);
+    world.textures.push_back(checker);
+    prism::Image stripes(4, 4);
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 4; ++x) stripes(x, y) = glm::vec3(float(x) / 4, 0.5f, float(y) / 4);
+    world.images.push_back({"in-code", std::make_shared<const prism::Image>(std::move(stripes)), false});
+    scene::Texture painted;
+    painted.kind = scene::TextureKind::image;
+    painted.decal_mode = scene::DecalMode::replace_all;
+    painted.normalizer = 1;
+    world.textures.push_back(painted);
+    scene::Mesh floor;
+    floor.material = 0;
+    floor.positions = {{-8, -1, -8}, {8, -1, -8}, {8, -1, 8}, {-8, -1, 8}};
+    floor.triangles = {{0, 2, 1}, {0, 3, 2}};
+    floor.textures = {0};
+    world.meshes.push_back(floor);
+    world.spheres.push_back({"glass ball", 1, {-1.3, 0, 0.5}, 1, glm::dmat4(1.0)});
+    world.spheres.push_back({"rough ball", 2, {1.2, 0.1, -0.6}, 1.1, glm::dmat4(1.0)});
+    world.spheres.push_back({"copper ball", 3, {0.2, 2.1, -2}, 0.6, glm::dmat4(1.0)});
+    scene::Sphere painted_ball{"painted ball", 4, {-2.6, 1.8, -1.5}, 0.5, glm::dmat4(1.0)};
+    painted_ball.textures = {1};
+    world.spheres.push_back(painted_ball);
+    world.planes.push_back({"wall", 4, {0, 0, -6}, {0, 0, 1}, glm::dmat4(1.0)});
+    world.point_lights.push_back({"key", {3, 6, 4}, {60, 60, 60}});
+    world.point_lights.push_back({"fill", {-4, 3, 2}, {15, 12, 10}});
+    world.directional_lights.push_back({"sun", {0.3, -1, -0.4}, {0.4, 0.4, 0.35}});
+    world.spot_lights.push_back({"spot", {0, 5, 1}, {0, -1, -0.2}, {80, 70, 60}, 50, 30});
+    world.area_lights.push_back({"panel", {-1, 4.5, -1}, {2, 0, 0}, {0, 0, 2}, {6, 6, 6}});
+    world.ambient_light = glm::dvec3(0.05);
+    world.max_recursion_depth = 4;
+    scene::Mesh tent;  // a ridged sheet of 72 triangles behind the balls, transformed: the scene keeps its index
+    tent.material = 4;
+    for (int z = 0; z <= 6; ++z)
+        for (int x = 0; x <= 6; ++x) tent.positions.push_back({x / 3.0 - 1, ((x + z) % 2) * 0.2, z / 3.0 - 1});
+    for (std::uint32_t z = 0; z < 6; ++z)
+        for (std::uint32_t x = 0; x < 6; ++x) {
+            const std::uint32_t a = z * 7 + x;
+            tent.triangles.push_back({a, a + 7, a + 8});
+            tent.triangles.push_back({a, a + 8, a + 1});
+        }
+    tent.transform = glm::translate(glm::dmat4(1.0), glm::dvec3(2.8, 1.5, -3)) *
+                     glm::rotate(glm::dmat4(1.0), 1.2, glm::dvec3(1, 0.2, 0));
+    using Complete = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::AllLightSet, prism::all_features>;
+    using Whole = prism::Renderer<Complete>;
+    for (const bool indexed : {false, true}) {
+        CAPTURE(indexed);
+        if (indexed) world.meshes.push_back(tent);
+        for (const prism::RayOffset offset : {prism::RayOffset::scene_epsilon, prism::RayOffset::error_bound}) {
+            CAPTURE(int(offset));
+            for (const int count : {5, 16, 40}) {
+                CAPTURE(count);
+                world.cameras[0].num_samples = count;
+                const prism::RendererSettings settings{prism::BackfaceCulling::flat_triangles, offset, 7};
+                const Whole renderer(world, settings);
+                const prism::Image image = renderer.render(world.cameras[0]);
+                // The renderer's parts, made as Renderer's constructor makes them.
+                const typename Whole::Geometry geometry(world);
+                const typename Whole::LightSetT lights(world);
+                std::vector<prism::Material<Real>> materials;
+                for (const scene::Material& material : world.materials) materials.emplace_back(material);
+                const typename Whole::TexturesT textures(world);
+                const typename Whole::EnvironmentT environment(*lights.template of_type<prism::EnvironmentLight>());
+                const typename Whole::Integrator integrator(
+                    geometry, lights, materials, textures, environment, prism::Vec3<Real>(world.ambient_light),
+                    prism::Vec3<Real>(world.background_color),
+                    prism::IntegratorSettings{world.max_recursion_depth, world.shadow_ray_epsilon, offset,
+                                              settings.backface_culling});
+                REQUIRE(integrator.prelights());
+                const prism::ThinLensCamera<Real> lens(world.cameras[0], camera.width, camera.height);
+                std::vector<prism::CameraSample<Real>> samples;
+                std::vector<prism::Vec2<Real>> strata;
+                int mismatches = 0, distinct = 0;
+                std::set<std::array<float, 3>> colours;
+                for (int y = 0; y < camera.height; ++y)
+                    for (int x = 0; x < camera.width; ++x) {
+                        prism::Random random = prism::Random::for_pixel(x, y, settings.seed);
+                        typename Whole::Integrator::CameraPath path{
+                            random,
+                            prism::Vec2<Real>((Real(x) + Real(0.5)) / Real(camera.width),
+                                              (Real(y) + Real(0.5)) / Real(camera.height)),
+                            lens.pixel_spread()};
+                        prism::camera_samples(count, random, samples, strata);
+                        prism::Vec3<Real> sum(0);
+                        Real weights = 0;
+                        for (const prism::CameraSample<Real>& sample : samples) {
+                            const prism::Ray<Real> ray = lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y,
+                                                                  sample.lens, sample.time);
+                            const Real weight = prism::filter_weight(camera.filter, sample.pixel);
+                            sum += weight * integrator.radiance(ray, path);
+                            weights += weight;
+                        }
+                        const glm::vec3 expected(sum / weights);
+                        mismatches += std::memcmp(&expected, &image(x, y), sizeof expected) != 0;
+                        colours.insert({expected.r, expected.g, expected.b});
+                    }
+                distinct = int(colours.size());
+                CHECK(mismatches == 0);
+                CHECK(distinct > 100);  // of 140 pixels: the scene's variety reaches the image
+            }
+        }
+    }
+}
+
 TEST_CASE_TEMPLATE("Whitted: seven point lights add up, in their order, as each alone gives it, bit for bit", Real,
                    float, double) {
     // A guard for any reordering of the light loop (whole9 measured batching the lights' shadow
