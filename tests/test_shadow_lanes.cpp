@@ -1,8 +1,10 @@
 // Shadow rays side by side through an index (WideBvhTree::traverse_any_lanes,
 // SceneGeometry::occluded_side_by_side in scenes with a top-level index): each ray must reach
 // exactly the leaves it reaches alone and get the answer occluded gives it alone, whatever rays
-// share its lanes. And the world-space indices of one or two leaves, tested leaf by leaf in an
-// index scene, must give intersect's hits as the exhaustive test gives them.
+// share its lanes. Camera rays side by side (WideBvhTree::traverse_closest_lanes,
+// SceneGeometry::intersect_each through the index) must get intersect's hits, ties included.
+// And the world-space indices of one or two leaves, tested leaf by leaf in an index scene, must
+// give intersect's hits as the exhaustive test gives them.
 #include <prism/accel/accelerator.hpp>
 #include <prism/accel/wide_bvh_tree.hpp>
 #include <prism/geometry/scene_geometry.hpp>
@@ -313,4 +315,94 @@ TEST_CASE_TEMPLATE("SceneGeometry: an index scene's one-leaf world mesh gives th
     }
     CHECK(differ == 0);
     CHECK(floor_hits > 5000);
+}
+
+// Camera rays side by side through the index (SceneGeometry::intersect_each in a scene with a
+// top-level index: intersect_through_index, WideBvhTree::traverse_closest_lanes): 1 to 32 rays,
+// a pixel's samples (nearly one direction), a row's, rays from anywhere, and rays aimed exactly
+// at the grids' vertices and edge midpoints, where neighbouring triangles tie and the leaves'
+// order decides (the tied rays are traced again alone). Every ray's hit, t_max and answer must
+// be intersect's, bit for bit, under each culling rule, still and moving, Watertight and (in
+// float) DoubleRefine.
+TEST_CASE_TEMPLATE("SceneGeometry: camera rays side by side through the index get intersect's hits", Real, float,
+                   double) {
+    using prism::BackfaceCulling;
+    for (const bool moving : {false, true}) {
+        CAPTURE(moving);
+        const scene::Scene world = index_scene(moving);
+        // The grids' vertices and edge midpoints in world space: targets where triangles meet.
+        std::vector<glm::dvec3> corners;
+        for (std::size_t m : {std::size_t(0), std::size_t(2)}) {
+            const scene::Mesh& mesh = world.meshes[m];
+            for (const auto& face : mesh.triangles)
+                for (int k = 0; k < 3; ++k) {
+                    const glm::dvec3 a = mesh.positions[face[std::size_t(k)]], b = mesh.positions[face[std::size_t((k + 1) % 3)]];
+                    for (const glm::dvec3& p : {a, 0.5 * (a + b)})
+                        corners.push_back(glm::dvec3(mesh.transform * glm::dvec4(p, 1.0)));
+                }
+        }
+        const auto check = [&](const auto& geometry) {
+            REQUIRE_FALSE(geometry.intersection_batches());
+            std::mt19937 random(moving ? 15 : 14);
+            std::uniform_real_distribution<double> uniform(-1, 1), fraction(0, 1);
+            std::size_t rays = 0, hit_rays = 0, edge_hits = 0, differ = 0;
+            for (int batch = 0; batch < 1200; ++batch) {
+                const int count = 1 + int(fraction(random) * 32);
+                const glm::dvec3 camera(2 * uniform(random), 1.5 + uniform(random), 8);
+                const glm::dvec3 aim = glm::normalize(glm::dvec3(0.4 * uniform(random), -0.3 + 0.2 * uniform(random), -1));
+                const Real time = Real(fraction(random));
+                std::vector<prism::Ray<Real>> start;
+                for (int i = 0; i < count; ++i) {
+                    glm::dvec3 origin = camera, direction;
+                    switch (batch % 4) {
+                        case 0: direction = glm::normalize(aim + 1e-3 * glm::dvec3(uniform(random), uniform(random), 0)); break;
+                        case 1: direction = glm::normalize(aim + glm::dvec3(-0.3 + 0.6 * i / count, 0.02 * uniform(random), 0)); break;
+                        case 2:
+                            origin = 5.0 * glm::dvec3(uniform(random), uniform(random), uniform(random));
+                            direction = random_unit(random);
+                            break;
+                        default:
+                            direction = glm::normalize(corners[std::size_t(random()) % corners.size()] - origin);
+                            break;
+                    }
+                    start.push_back({prism::Vec3<Real>(origin), prism::Vec3<Real>(direction), Real(batch % 5 == 0 ? 1e-3 : 0),
+                                     batch % 7 == 0 ? Real(6) : prism::infinity<Real>, time});
+                }
+                const auto compare = [&]<BackfaceCulling Culling>() {
+                    std::vector<prism::Ray<Real>> alone = start, together = start;
+                    std::vector<prism::Hit<Real>> hits_alone(static_cast<std::size_t>(count)), hits_together(static_cast<std::size_t>(count));
+                    std::uint32_t expected = 0;
+                    for (int i = 0; i < count; ++i)
+                        if (geometry.template intersect<Culling>(alone[std::size_t(i)], hits_alone[std::size_t(i)]))
+                            expected |= std::uint32_t(1) << i;
+                    const std::uint32_t found = geometry.template intersect_each<Culling>(together.data(), hits_together.data(), count);
+                    differ += found != expected;
+                    for (int i = 0; i < count; ++i) {
+                        const auto& a = hits_alone[std::size_t(i)];
+                        const auto& b = hits_together[std::size_t(i)];
+                        differ += !same_bits(alone[std::size_t(i)].t_max, together[std::size_t(i)].t_max);
+                        if (!((expected >> i) & 1)) continue;
+                        differ += !same_bits(a.t, b.t) || a.object != b.object || a.primitive != b.primitive ||
+                                  !same_bits(a.b1, b.b1) || !same_bits(a.b2, b.b2);
+                        ++hit_rays;
+                        edge_hits += a.b1 == 0 || a.b2 == 0 || a.b1 + a.b2 == 1;
+                    }
+                    rays += std::size_t(count);
+                };
+                compare.template operator()<BackfaceCulling::none>();
+                compare.template operator()<BackfaceCulling::flat_triangles>();
+                compare.template operator()<BackfaceCulling::all>();
+            }
+            CHECK(differ == 0);
+            CHECK(hit_rays > rays / 2);
+            CHECK(edge_hits > 100);  // rays through shared edges and vertices, where the order decides a tie
+        };
+        if (moving) {
+            check(prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>, true>(world));
+            check(prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 4>, true>(world));
+        } else {
+            check(prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>(world));
+        }
+        if constexpr (std::is_same_v<Real, float>) check(prism::SceneGeometry<Real, prism::WideBvh<prism::DoubleRefine, 8>, true>(world));
+    }
 }

@@ -321,6 +321,101 @@ public:
         }
     }
 
+    // Closest hits for several rays at once (bit i of `lanes` for ray i, i < 32: a pixel's
+    // camera rays), each ray tested at a node only if it entered that node's box within its own
+    // current t_max, with its own slab set-up and traverse's node test, so each ray reaches
+    // every leaf that could hold a hit nearer than the one it has. The leaves are visited in
+    // one order for all the rays (nearest first by the nearest entry among them), not each
+    // ray's own: the closest hit is the same wherever it is unique, and the caller decides what
+    // a tie means (TriangleMesh::intersect_lanes).
+    // leaf(first, count, lanes) tests the leaf's primitives for the rays of `lanes`, lowers
+    // t_max[i] for each ray it hits and returns those rays; the answer is every ray hit.
+    template <class Leaf>
+    std::uint32_t traverse_closest_lanes(const TraversalRay* slabs, const Real* t_min, Real* t_max, std::uint32_t lanes,
+                                         Leaf&& leaf) const {
+        if (nodes_.empty() || lanes == 0) return 0;
+        struct LaneEntry {
+            std::uint64_t child;
+            std::uint32_t lanes;
+            Real nearest;  // the nearest entry of its rays into its box
+        };
+        std::array<LaneEntry, stack_size> stack;
+        alignas(64) Real far_limit[32];
+        Real farthest = 0;  // the largest far_limit of the rays: an entry beyond it is no ray's
+        for (std::uint32_t rest = lanes; rest != 0; rest &= rest - 1) {
+            const int i = std::countr_zero(rest);
+            far_limit[i] = t_max[i] * far_scale;
+            farthest = std::max(farthest, far_limit[i]);
+        }
+        const auto after_hits = [&](std::uint32_t hit) {
+            if (hit == 0) return;
+            for (std::uint32_t rest = hit; rest != 0; rest &= rest - 1) {
+                const int i = std::countr_zero(rest);
+                far_limit[i] = t_max[i] * far_scale;
+            }
+            farthest = 0;
+            for (std::uint32_t rest = lanes; rest != 0; rest &= rest - 1) farthest = std::max(farthest, far_limit[std::countr_zero(rest)]);
+        };
+        int size = 0;
+        std::uint32_t found = 0;
+        std::uint64_t current = 0;
+        std::uint32_t current_lanes = lanes;
+        for (;;) {
+            const Node& node = node_at(current);
+            // As traverse_any_lanes: the rays' hit masks transposed into the children's ray
+            // masks; and per child the nearest entry of the rays that enter it.
+            std::array<std::uint64_t, 4> rows{};
+            Pack nearest = Pack::broadcast(infinity<Real>);
+            for (std::uint32_t rest = current_lanes; rest != 0; rest &= rest - 1) {
+                const int i = std::countr_zero(rest);
+                Pack entry;
+                const auto entered = enter(node, slabs[i], t_min[i], far_limit[i], entry);
+                nearest = select(entered, simd::min_keep(entry, nearest), nearest);
+                rows[std::size_t(i >> 3)] |= std::uint64_t(entered.bits()) << (8 * (i & 7));
+            }
+            std::array<std::uint32_t, N> entering{};
+            for (int group = 0; group < 4; ++group) {
+                if (rows[std::size_t(group)] == 0) continue;
+                const std::uint64_t columns = transpose_bits(rows[std::size_t(group)]);
+                for (int c = 0; c < N; ++c)
+                    entering[std::size_t(c)] |= std::uint32_t((columns >> (8 * c)) & 0xff) << (8 * group);
+            }
+            // The entered children pushed farthest first, so that the nearest is popped first.
+            alignas(64) Real distances[N];
+            nearest.store(distances);
+            std::uint32_t children = 0;
+            for (int c = 0; c < N; ++c)
+                if (entering[std::size_t(c)] != 0) children |= std::uint32_t(1) << c;
+            const int first_pushed = size;
+            for (std::uint32_t rest = children; rest != 0; rest &= rest - 1) {
+                const int c = std::countr_zero(rest);
+                int place = first_pushed;
+                while (place < size && stack[std::size_t(place)].nearest >= distances[c]) ++place;
+                for (int k = size; k > place; --k) stack[std::size_t(k)] = stack[std::size_t(k - 1)];
+                stack[std::size_t(place)] = LaneEntry{node.child[c], entering[std::size_t(c)], distances[c]};
+                ++size;
+            }
+            // Pop until an inner node to descend into; leaves on the way are tested at once.
+            bool descend = false;
+            while (size > 0) {
+                const LaneEntry entry = stack[std::size_t(--size)];
+                if (entry.nearest > farthest) continue;
+                if (!Node::is_leaf_word(entry.child)) {
+                    current = entry.child;
+                    current_lanes = entry.lanes;
+                    descend = true;
+                    break;
+                }
+                PRISM_COUNT_LEAF(Node::leaf_count(entry.child), N);
+                const std::uint32_t hit =
+                    leaf(Node::leaf_first(entry.child), Node::leaf_count(entry.child), entry.lanes) & entry.lanes;
+                found |= hit;
+                after_hits(hit);
+            }
+            if (!descend) return found;
+        }
+    }
+
     // The 8x8 bit matrix whose row i is byte i of x, transposed (bit c of byte i becomes bit i
     // of byte c): three exchanges of 2x2 blocks of growing size (Warren, Hacker's Delight 7-3).
     static constexpr std::uint64_t transpose_bits(std::uint64_t x) {

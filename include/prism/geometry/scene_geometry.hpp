@@ -235,22 +235,7 @@ private:
                 found = true;
             }
         }
-        if (direct_top_) return intersect_direct<Culling>(ray, hit, found);
-        if (top_objects_.empty()) return intersect_planes<Culling>(ray, hit) || found;
-        const auto& order = top_.primitive_indices();
-        top_.traverse_closest(traversal_ray, ray.t_min, ray.t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_max) {
-            bool leaf_hit = false;
-            for (std::uint32_t i = first; i < first + count; ++i) {
-                const std::uint32_t object = top_objects_[order[i]];
-                if (intersect_instance<Culling>(instances_[object], ray, traversal_ray, world_triangle_ray, t_max, hit)) {
-                    hit.object = object;
-                    leaf_hit = true;
-                }
-            }
-            found |= leaf_hit;
-            return leaf_hit;
-        });
-        return intersect_planes<Culling>(ray, hit) || found;
+        return intersect_top<Culling>(ray, hit, found, traversal_ray, world_triangle_ray);
     }
 
 public:
@@ -346,6 +331,15 @@ public:
     std::uint32_t intersect_each(Ray<Real>* rays, Hit<Real>* hits, int count) const {
         std::uint32_t found = 0;
         if (!intersection_batches()) {
+            if constexpr (Mesh::packed) {
+                if (!direct_ && lanes_through_index()) {
+                    for (int first = 0; first < count; first += index_lanes)
+                        found |= intersect_through_index<Culling>(rays + first, hits + first,
+                                                                  std::min(index_lanes, count - first))
+                                 << first;
+                    return found;
+                }
+            }
             for (int i = 0; i < count; ++i)
                 if (intersect<Culling>(rays[i], hits[i])) found |= std::uint32_t(1) << i;
             return found;
@@ -771,6 +765,220 @@ private:
         return instance.transformed ? instance.to_object(ray) : ray;
     }
 
+    // intersect_indexed past the world meshes: the top level (direct or through its index),
+    // then the planes; `found` whether the world meshes were hit.
+    template <BackfaceCulling Culling>
+    [[gnu::always_inline]] bool intersect_top(Ray<Real>& ray, Hit<Real>& hit, bool found, const TraversalRay& traversal_ray,
+                                              std::optional<TriangleRay>& world_triangle_ray) const {
+        if (direct_top_) return intersect_direct<Culling>(ray, hit, found);
+        if (top_objects_.empty()) return intersect_planes<Culling>(ray, hit) || found;
+        const auto& order = top_.primitive_indices();
+        top_.traverse_closest(traversal_ray, ray.t_min, ray.t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_max) {
+            bool leaf_hit = false;
+            for (std::uint32_t i = first; i < first + count; ++i) {
+                const std::uint32_t object = top_objects_[order[i]];
+                if (intersect_instance<Culling>(instances_[object], ray, traversal_ray, world_triangle_ray, t_max, hit)) {
+                    hit.object = object;
+                    leaf_hit = true;
+                }
+            }
+            found |= leaf_hit;
+            return leaf_hit;
+        });
+        return intersect_planes<Culling>(ray, hit) || found;
+    }
+
+    // Whether intersect_each takes an index scene's rays together (intersect_through_index):
+    // where the top level has its index, or a world mesh has a tree to traverse, not only a
+    // root of one or two leaves.
+    bool lanes_through_index() const {
+        if (!direct_top_ && !top_objects_.empty()) return true;
+        for (const WorldMeshes& group : world_meshes_)
+            if (!group.leaves) return true;
+        return false;
+    }
+
+    // intersect_each in a scene traversed through its index (no direct form), for up to
+    // index_lanes rays: each world mesh's closest hits for the rays together
+    // (TriangleMesh::intersect_lanes: each ray set up and tested as intersect_indexed sets it up
+    // and tests it, the leaves visited in one order for all), then each ray's top level and
+    // planes on its own (intersect_top). A pixel's camera rays reach the same nodes, whose
+    // tests then overlap instead of each waiting on the one before. A ray whose hit in a mesh
+    // may depend on that order (a tie) is traced through that mesh again on its own, from
+    // where it was before the mesh, so every ray's hit is intersect's.
+    template <BackfaceCulling Culling>
+    std::uint32_t intersect_through_index(Ray<Real>* rays, Hit<Real>* hits, int count) const
+        requires Mesh::packed
+    {
+        const std::uint32_t present = (std::uint32_t(1) << count) - 1;
+        Unconstructed<TraversalRay, index_lanes> traversal;
+        Unconstructed<TriangleRay, index_lanes> world_triangle;  // made for the lanes that first enter a world-space mesh
+        std::uint32_t made = 0;
+        alignas(64) Real t_min[index_lanes], t_max[index_lanes];
+        for (int i = 0; i < count; ++i) {
+            traversal.make(std::size_t(i), rays[i]);
+            t_min[i] = rays[i].t_min;
+            t_max[i] = rays[i].t_max;
+        }
+        std::uint32_t found = 0;
+        for (const WorldMeshes& group : world_meshes_) {
+            const Mesh& index = index_of(group);
+            const bool cull = culls_back_faces(Culling, group.smooth);
+            std::uint32_t lanes = 0;
+            for (std::uint32_t rest = present; rest != 0; rest &= rest - 1) {
+                const int i = std::countr_zero(rest);
+                if (index.enters(traversal[std::size_t(i)], t_min[i], t_max[i])) lanes |= std::uint32_t(1) << i;
+            }
+            if (lanes == 0) continue;
+            for (std::uint32_t missing = lanes & ~made; missing != 0; missing &= missing - 1) {
+                const int i = std::countr_zero(missing);
+                world_triangle.make(std::size_t(i), rays[i]);
+            }
+            made |= lanes;
+            // What a tied ray is traced again from.
+            std::array<Real, index_lanes> t_before;
+            Unconstructed<Hit<Real>, index_lanes> hit_before;
+            for (std::uint32_t rest = lanes; rest != 0; rest &= rest - 1) {
+                const int i = std::countr_zero(rest);
+                t_before[std::size_t(i)] = t_max[i];
+                hit_before.make(std::size_t(i), hits[i]);
+            }
+            std::uint32_t tied = 0;
+            std::uint32_t group_hits =
+                cull ? index.template intersect_lanes<true>(rays, traversal.data(), world_triangle.data(), t_min, t_max, lanes,
+                                                            hits, tied)
+                     : index.template intersect_lanes<false>(rays, traversal.data(), world_triangle.data(), t_min, t_max,
+                                                             lanes, hits, tied);
+            for (; tied != 0; tied &= tied - 1) {
+                const int i = std::countr_zero(tied);
+                const std::uint32_t bit = std::uint32_t(1) << i;
+                t_max[i] = t_before[std::size_t(i)];
+                hits[i] = hit_before[std::size_t(i)];
+                rays[i].t_max = t_max[i];
+                const bool hit = cull ? index.template intersect<true>(rays[i], traversal[std::size_t(i)], world_triangle[std::size_t(i)],
+                                                                       t_max[i], hits[i])
+                                      : index.template intersect<false>(rays[i], traversal[std::size_t(i)],
+                                                                        world_triangle[std::size_t(i)], t_max[i], hits[i]);
+                group_hits = hit ? group_hits | bit : group_hits & ~bit;
+            }
+            for (std::uint32_t rest = group_hits; rest != 0; rest &= rest - 1) {
+                const int i = std::countr_zero(rest);
+                Hit<Real>& hit = hits[i];
+                if (group.index) group.attribute(index.source_triangle(hit.primitive), hit);
+                else hit.object = group.objects[0];
+            }
+            found |= group_hits;
+        }
+        std::uint32_t answer = 0;
+        if (direct_top_ || top_objects_.empty()) {
+            for (int i = 0; i < count; ++i) {
+                rays[i].t_max = t_max[i];
+                // Made again where a top-level mesh in world space needs it (its set-up is the
+                // ray's alone, so the same bits).
+                std::optional<TriangleRay> world_triangle_ray;
+                if (intersect_top<Culling>(rays[i], hits[i], (found >> i) & 1, traversal[std::size_t(i)], world_triangle_ray))
+                    answer |= std::uint32_t(1) << i;
+            }
+            return answer;
+        }
+        // The top level's instances for the rays together, as intersect_top tests them one ray
+        // at a time; a ray tied anywhere in it is traced through it again on its own.
+        std::array<Real, index_lanes> t_before;
+        Unconstructed<Hit<Real>, index_lanes> hit_before;
+        for (int i = 0; i < count; ++i) {
+            t_before[std::size_t(i)] = t_max[i];
+            hit_before.make(std::size_t(i), hits[i]);
+        }
+        std::uint32_t tied = 0;
+        const auto& order = top_.primitive_indices();
+        const std::uint32_t top_hits = top_.traverse_closest_lanes(
+            traversal.data(), t_min, t_max, present, [&](std::uint32_t first, std::uint32_t objects, std::uint32_t testing) {
+                std::uint32_t hit = 0;
+                for (std::uint32_t k = first; k < first + objects; ++k) {
+                    const std::uint32_t object = top_objects_[order[k]];
+                    const Instance& instance = instances_[object];
+                    std::uint32_t instance_hits = 0;
+                    if (instance.kind == Kind::mesh && in_world_space(instance)) {
+                        for (std::uint32_t missing = testing & ~made; missing != 0; missing &= missing - 1) {
+                            const int i = std::countr_zero(missing);
+                            world_triangle.make(std::size_t(i), rays[i]);
+                        }
+                        made |= testing;
+                        const Mesh& mesh = meshes_[instance.shape];
+                        instance_hits = culls_back_faces(Culling, mesh.smooth())
+                                            ? mesh.template intersect_lanes<true>(rays, traversal.data(), world_triangle.data(),
+                                                                                  t_min, t_max, testing, hits, tied)
+                                            : mesh.template intersect_lanes<false>(rays, traversal.data(), world_triangle.data(),
+                                                                                   t_min, t_max, testing, hits, tied);
+                    } else {
+                        instance_hits = intersect_in_object_space<Culling>(instance, rays, t_min, t_max, testing, hits, tied);
+                    }
+                    for (std::uint32_t rest = instance_hits; rest != 0; rest &= rest - 1)
+                        hits[std::countr_zero(rest)].object = object;
+                    hit |= instance_hits;
+                }
+                return hit;
+            });
+        const std::uint32_t world_found = found;
+        found |= top_hits;
+        for (int i = 0; i < count; ++i) {
+            const std::uint32_t bit = std::uint32_t(1) << i;
+            if (tied & bit) {
+                t_max[i] = t_before[std::size_t(i)];
+                hits[i] = hit_before[std::size_t(i)];
+                rays[i].t_max = t_max[i];
+                std::optional<TriangleRay> world_triangle_ray;
+                if (intersect_top<Culling>(rays[i], hits[i], (world_found & bit) != 0, traversal[std::size_t(i)],
+                                           world_triangle_ray))
+                    answer |= bit;
+                continue;
+            }
+            rays[i].t_max = t_max[i];
+            if (intersect_planes<Culling>(rays[i], hits[i]) || (found & bit)) answer |= bit;
+        }
+        return answer;
+    }
+
+    // intersect_instance for the rays of `lanes` and an object not in world space: each ray
+    // taken to its object space and set up there as intersect_instance does; `tied` as
+    // TriangleMesh::intersect_lanes sets it (a sphere's hit at the t_max it was given, too).
+    template <BackfaceCulling Culling>
+    std::uint32_t intersect_in_object_space(const Instance& instance, const Ray<Real>* rays, const Real* t_min, Real* t_max,
+                                            std::uint32_t lanes, Hit<Real>* hits, std::uint32_t& tied) const
+        requires Mesh::packed
+    {
+        std::uint32_t hit = 0;
+        if (instance.kind != Kind::mesh) {
+            for (; lanes != 0; lanes &= lanes - 1) {
+                const int i = std::countr_zero(lanes);
+                Real t;
+                if (!spheres_[instance.shape].intersect(to_object(instance, rays[i]), rays[i].t_min, t_max[i], t)) continue;
+                if (!(t < t_max[i])) tied |= std::uint32_t(1) << i;
+                t_max[i] = t;
+                hits[i].t = t;
+                hits[i].primitive = 0;
+                hits[i].b1 = hits[i].b2 = 0;
+                hit |= std::uint32_t(1) << i;
+            }
+            return hit;
+        }
+        Unconstructed<Ray<Real>, index_lanes> local;
+        Unconstructed<TraversalRay, index_lanes> traversal;
+        Unconstructed<TriangleRay, index_lanes> triangle;
+        for (std::uint32_t rest = lanes; rest != 0; rest &= rest - 1) {
+            const std::size_t i = std::size_t(std::countr_zero(rest));
+            const Ray<Real>& ray = local.make(i, to_object(instance, rays[i]));
+            traversal.make(i, ray);
+            triangle.make(i, ray);
+        }
+        const Mesh& mesh = meshes_[instance.shape];
+        return culls_back_faces(Culling, mesh.smooth())
+                   ? mesh.template intersect_lanes<true>(local.data(), traversal.data(), triangle.data(), t_min, t_max, lanes,
+                                                         hits, tied)
+                   : mesh.template intersect_lanes<false>(local.data(), traversal.data(), triangle.data(), t_min, t_max, lanes,
+                                                          hits, tied);
+    }
+
     // occluded_side_by_side in a scene traversed through its index (no direct form), for up to
     // index_lanes rays: every level's any hits found for the rays together, each ray set up and
     // tested as occluded sets it up and tests it (WideBvhTree::traverse_any_lanes), so each
@@ -918,8 +1126,11 @@ private:
         Real t;
         if (!spheres_[instance.shape].intersect(local, ray.t_min, t_max, t)) return false;
         t_max = t;
+        // The whole record, barycentrics too: what a hit leaves is then the same whichever
+        // hits it replaced (intersect_through_index takes them in another order).
         hit.t = t;
         hit.primitive = 0;
+        hit.b1 = hit.b2 = 0;
         return true;
     }
 

@@ -283,6 +283,36 @@ public:
         });
     }
 
+    // intersect for the rays of `lanes` at once (bit i: rays[i], set up as traversal[i] and
+    // triangle[i]), each from t_min[i] up to its own t_max[i], which is lowered as hits[i] is
+    // filled (WideBvhTree::traverse_closest_lanes; the leaf's packet test of each ray). Returns
+    // the rays hit. A ray's closest hit is intersect's wherever it is the one nearest hit, and
+    // `tied` gets the rays whose hit may depend on the order the leaves were visited in: a
+    // leaf's hit at the t_max it was given (the packet test takes a later tie, and with
+    // DoubleRefine two hits rounding to one float t are such a tie). The caller traces those
+    // again with intersect, from what they had before.
+    template <bool CullBackfaces>
+    std::uint32_t intersect_lanes(const Ray<Real>* rays, const TraversalRay* traversal, const TriangleRay* triangle,
+                                  const Real* t_min, Real* t_max, std::uint32_t lanes, Hit<Real>* hits,
+                                  std::uint32_t& tied) const
+        requires packed
+    {
+        return index_.traverse_closest_lanes(
+            traversal, t_min, t_max, lanes, [&](std::uint32_t first, std::uint32_t count, std::uint32_t testing) {
+                std::uint32_t hit = 0;
+                for (; testing != 0; testing &= testing - 1) {
+                    const int i = std::countr_zero(testing);
+                    const Real before = t_max[i];
+                    if (!packets_.template intersect<CullBackfaces>(triangle[i].packed_ray, rays[i].direction, first, count,
+                                                                    rays[i].t_min, t_max[i], hits[i]))
+                        continue;
+                    hit |= std::uint32_t(1) << i;
+                    if (!(t_max[i] < before)) tied |= std::uint32_t(1) << i;
+                }
+                return hit;
+            });
+    }
+
     // occluded for the rays of `lanes` at once (bit i: rays[i], set up as traversal[i] and
     // triangle[i]), each up to its own t_max: the blocked ones, each answered as occluded
     // answers it (WideBvhTree::traverse_any_lanes; the leaf's packet test of each ray).
