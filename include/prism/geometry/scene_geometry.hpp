@@ -325,8 +325,9 @@ public:
     // (count <= 32). Under intersection_batches() the world meshes' leaves are tested against
     // several rays at once (TriangleMesh::intersect_leaf_lanes, lane by lane the leaf test's
     // bits), group after group as intersect takes them, then the direct spheres likewise
-    // (intersect_direct_spheres_lanes), each ray then the planes on its own; elsewhere each
-    // ray is intersect's.
+    // (intersect_direct_spheres_lanes), each ray then the planes on its own; in scenes with an
+    // index of more than a leaf or two, the rays traverse it together (intersect_through_index);
+    // elsewhere each ray is intersect's. Every ray's hit is intersect's, to the bit.
     template <BackfaceCulling Culling>
     std::uint32_t intersect_each(Ray<Real>* rays, Hit<Real>* hits, int count) const {
         std::uint32_t found = 0;
@@ -1350,6 +1351,7 @@ private:
             ray.t_max = t;
             hit.t = t;
             hit.primitive = 0;
+            hit.b1 = hit.b2 = 0;  // a sphere's whole record, as intersect_instance writes it
             hit.object = sphere.object;
             found = true;
         }
@@ -1413,6 +1415,7 @@ private:
                         rays[i].t_max = t;
                         hits[i].t = t;
                         hits[i].primitive = 0;
+                        hits[i].b1 = hits[i].b2 = 0;
                         hits[i].object = sphere.object;
                         found |= std::uint32_t(1) << i;
                     }
@@ -1463,6 +1466,7 @@ private:
                     rays[i].t_max = fields[7][i] = t_lanes[i];
                     hits[i].t = t_lanes[i];
                     hits[i].primitive = 0;
+                    hits[i].b1 = hits[i].b2 = 0;
                     hits[i].object = sphere.object;
                     found |= std::uint32_t(1) << i;
                 }

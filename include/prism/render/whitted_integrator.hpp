@@ -227,11 +227,11 @@ public:
         // shade's state at a camera hit up to its direct lighting (the point made in place).
         struct PrelitPoint {
             SurfacePoint<Real> point;
-            Vec3<Real> normal;
-            SpawnOrigins origins;
-            Real travelled;
+            Vec3<Real> normal{0};
+            SpawnOrigins origins{};
+            Real travelled = 0;
             std::uint32_t visible = 0;  // bit k: prelit light k's shadow ray is made and reaches it
-            bool front_face, inside_medium;
+            bool front_face = false, inside_medium = false;
         };
         Unconstructed<PrelitPoint, prelit_width> points;
         // Textures change a copy of the material; without them it is read where it is stored.
@@ -304,17 +304,17 @@ public:
                         owner[std::size_t(n++)] = i;
                     }
                 } else {
-                  for (std::uint32_t rest = lighting; rest != 0; rest &= rest - 1) {
-                    const int i = std::countr_zero(rest);
-                    PrelitPoint& at = points[std::size_t(i)];
-                    const LightSample<Real> sample = light.sample(ShadingFrame<Real>{at.point.position, at.normal});
-                    directions[j][std::size_t(i)] = sample.direction;
-                    radiances[j][std::size_t(i)] = sample.radiance;
-                    cosines[j][std::size_t(i)] = glm::dot(at.normal, sample.direction);
-                    if (cosines[j][std::size_t(i)] <= 0) continue;
-                    make_shadow_ray(shadows.make(std::size_t(n)), at.point, at.normal, sample, at.origins);
-                    owner[std::size_t(n++)] = i;
-                  }
+                    for (std::uint32_t rest = lighting; rest != 0; rest &= rest - 1) {
+                        const int i = std::countr_zero(rest);
+                        PrelitPoint& at = points[std::size_t(i)];
+                        const LightSample<Real> sample = light.sample(ShadingFrame<Real>{at.point.position, at.normal});
+                        directions[j][std::size_t(i)] = sample.direction;
+                        radiances[j][std::size_t(i)] = sample.radiance;
+                        cosines[j][std::size_t(i)] = glm::dot(at.normal, sample.direction);
+                        if (cosines[j][std::size_t(i)] <= 0) continue;
+                        make_shadow_ray(shadows.make(std::size_t(n)), at.point, at.normal, sample, at.origins);
+                        owner[std::size_t(n++)] = i;
+                    }
                 }
                 if (n == 0) return;
                 const std::uint32_t blocked = geometry_.occluded_side_by_side(shadows.data(), n);
