@@ -44,6 +44,24 @@ scene::Material matte(double albedo) {
     return material;
 }
 
+// A ridged sheet of 72 triangles, transformed (rotated and moved behind the test scenes' balls):
+// a scene that holds it keeps its top-level index.
+scene::Mesh ridged_tent(std::size_t material) {
+    scene::Mesh tent;
+    tent.material = material;
+    for (int z = 0; z <= 6; ++z)
+        for (int x = 0; x <= 6; ++x) tent.positions.push_back({x / 3.0 - 1, ((x + z) % 2) * 0.2, z / 3.0 - 1});
+    for (std::uint32_t z = 0; z < 6; ++z)
+        for (std::uint32_t x = 0; x < 6; ++x) {
+            const std::uint32_t a = z * 7 + x;
+            tent.triangles.push_back({a, a + 7, a + 8});
+            tent.triangles.push_back({a, a + 8, a + 1});
+        }
+    tent.transform = glm::translate(glm::dmat4(1.0), glm::dvec3(2.8, 1.5, -3)) *
+                     glm::rotate(glm::dmat4(1.0), 1.2, glm::dvec3(1, 0.2, 0));
+    return tent;
+}
+
 }  // namespace
 
 TEST_CASE_TEMPLATE("Random: reproducible per pixel, uniform in [0, 1), streams differ", Real, float, double) {
@@ -343,20 +361,7 @@ TEST_CASE_TEMPLATE("Renderer: a row's mirrors and conductors, their reflections 
     // Indexed: a transformed mesh of 72 triangles joins the top level, which then keeps its
     // index (SceneGeometry::occluded_through_index's rows of shadow rays, intersect one ray at
     // a time); it stands behind the balls, where the floor and the copper ball reflect it.
-    scene::Mesh tent;
-    {
-        tent.material = 2;
-        for (int z = 0; z <= 6; ++z)
-            for (int x = 0; x <= 6; ++x) tent.positions.push_back({x / 3.0 - 1, ((x + z) % 2) * 0.2, z / 3.0 - 1});
-        for (std::uint32_t z = 0; z < 6; ++z)
-            for (std::uint32_t x = 0; x < 6; ++x) {
-                const std::uint32_t a = z * 7 + x;
-                tent.triangles.push_back({a, a + 7, a + 8});
-                tent.triangles.push_back({a, a + 8, a + 1});
-            }
-        tent.transform = glm::translate(glm::dmat4(1.0), glm::dvec3(2.8, 1.5, -3)) *
-                         glm::rotate(glm::dmat4(1.0), 1.2, glm::dvec3(1, 0.2, 0));
-    }
+    const scene::Mesh tent = ridged_tent(2);
     for (const bool indexed : {false, true}) {
         CAPTURE(indexed);
         if (indexed) world.meshes.push_back(tent);
@@ -464,18 +469,7 @@ TEST_CASE_TEMPLATE("Renderer: a pixel's samples lit side by side (radiances_at) 
     world.area_lights.push_back({"panel", {-1, 4.5, -1}, {2, 0, 0}, {0, 0, 2}, {6, 6, 6}});
     world.ambient_light = glm::dvec3(0.05);
     world.max_recursion_depth = 4;
-    scene::Mesh tent;  // a ridged sheet of 72 triangles behind the balls, transformed: the scene keeps its index
-    tent.material = 4;
-    for (int z = 0; z <= 6; ++z)
-        for (int x = 0; x <= 6; ++x) tent.positions.push_back({x / 3.0 - 1, ((x + z) % 2) * 0.2, z / 3.0 - 1});
-    for (std::uint32_t z = 0; z < 6; ++z)
-        for (std::uint32_t x = 0; x < 6; ++x) {
-            const std::uint32_t a = z * 7 + x;
-            tent.triangles.push_back({a, a + 7, a + 8});
-            tent.triangles.push_back({a, a + 8, a + 1});
-        }
-    tent.transform = glm::translate(glm::dmat4(1.0), glm::dvec3(2.8, 1.5, -3)) *
-                     glm::rotate(glm::dmat4(1.0), 1.2, glm::dvec3(1, 0.2, 0));
+    const scene::Mesh tent = ridged_tent(4);  // behind the balls: the scene keeps its index
     using Complete = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::AllLightSet, prism::all_features>;
     using Whole = prism::Renderer<Complete>;
     for (const bool indexed : {false, true}) {

@@ -260,24 +260,8 @@ public:
         std::uint32_t current_lanes = lanes;
         for (;;) {
             const Node& node = node_at(current);
-            // Which rays enter each child: the rays' hit masks are the rows of a bit matrix
-            // (byte i % 8 of rows[i / 8] for ray i), transposed eight by eight into the
-            // children's ray masks, with no branch on any ray's hits (a loop over each ray's
-            // hit bits mispredicted at about every node).
-            std::array<std::uint64_t, 4> rows{};
-            for (std::uint32_t rest = current_lanes; rest != 0; rest &= rest - 1) {
-                const int i = std::countr_zero(rest);
-                Pack entry;
-                const std::uint64_t hits = enter(node, slabs[i], t_min[i], far_limit[i], entry).bits();
-                rows[std::size_t(i >> 3)] |= hits << (8 * (i & 7));
-            }
-            std::array<std::uint32_t, N> entering{};
-            for (int group = 0; group < 4; ++group) {
-                if (rows[std::size_t(group)] == 0) continue;
-                const std::uint64_t columns = transpose_bits(rows[std::size_t(group)]);
-                for (int c = 0; c < N; ++c)
-                    entering[std::size_t(c)] |= std::uint32_t((columns >> (8 * c)) & 0xff) << (8 * group);
-            }
+            const std::array<std::uint32_t, N> entering =
+                children_entered(node, slabs, t_min, far_limit, current_lanes, [](int, const auto&, const Pack&) {});
             // The leaves first, as traverse_any tests them: a shadow ray ends at its first blocker.
             std::uint32_t inner = 0;
             for (int c = 0; c < N; ++c) {
@@ -362,24 +346,11 @@ public:
         std::uint32_t current_lanes = lanes;
         for (;;) {
             const Node& node = node_at(current);
-            // As traverse_any_lanes: the rays' hit masks transposed into the children's ray
-            // masks; and per child the nearest entry of the rays that enter it.
-            std::array<std::uint64_t, 4> rows{};
+            // Per child, the rays that enter it and the nearest entry among them.
             Pack nearest = Pack::broadcast(infinity<Real>);
-            for (std::uint32_t rest = current_lanes; rest != 0; rest &= rest - 1) {
-                const int i = std::countr_zero(rest);
-                Pack entry;
-                const auto entered = enter(node, slabs[i], t_min[i], far_limit[i], entry);
-                nearest = select(entered, simd::min_keep(entry, nearest), nearest);
-                rows[std::size_t(i >> 3)] |= std::uint64_t(entered.bits()) << (8 * (i & 7));
-            }
-            std::array<std::uint32_t, N> entering{};
-            for (int group = 0; group < 4; ++group) {
-                if (rows[std::size_t(group)] == 0) continue;
-                const std::uint64_t columns = transpose_bits(rows[std::size_t(group)]);
-                for (int c = 0; c < N; ++c)
-                    entering[std::size_t(c)] |= std::uint32_t((columns >> (8 * c)) & 0xff) << (8 * group);
-            }
+            const std::array<std::uint32_t, N> entering = children_entered(
+                node, slabs, t_min, far_limit, current_lanes,
+                [&](int, const auto& entered, const Pack& entry) { nearest = select(entered, simd::min_keep(entry, nearest), nearest); });
             // The entered children pushed farthest first, so that the nearest is popped first.
             alignas(64) Real distances[N];
             nearest.store(distances);
@@ -414,6 +385,35 @@ public:
             }
             if (!descend) return found;
         }
+    }
+
+    // Which rays of `lanes` enter each child of `node` (bit i of entering[c] for ray i), each
+    // by its own node test (enter, with its own slab set-up, t_min and far_limit); `each(i,
+    // mask, entry)` sees each ray's test. The rays' hit masks are the rows of a bit matrix (byte
+    // i % 8 of rows[i / 8] for ray i), transposed eight by eight into the children's ray masks,
+    // with no branch on any ray's hits (a loop over each ray's hit bits mispredicted at about
+    // every node).
+    template <class Each>
+    [[gnu::always_inline]] static std::array<std::uint32_t, N> children_entered(const WideBvhNode<Real, N>& node,
+                                                                                 const TraversalRay* slabs, const Real* t_min,
+                                                                                 const Real* far_limit, std::uint32_t lanes,
+                                                                                 Each&& each) {
+        std::array<std::uint64_t, 4> rows{};
+        for (std::uint32_t rest = lanes; rest != 0; rest &= rest - 1) {
+            const int i = std::countr_zero(rest);
+            Pack entry;
+            const auto entered = enter(node, slabs[i], t_min[i], far_limit[i], entry);
+            each(i, entered, entry);
+            rows[std::size_t(i >> 3)] |= std::uint64_t(entered.bits()) << (8 * (i & 7));
+        }
+        std::array<std::uint32_t, N> entering{};
+        for (int group = 0; group < 4; ++group) {
+            if (rows[std::size_t(group)] == 0) continue;
+            const std::uint64_t columns = transpose_bits(rows[std::size_t(group)]);
+            for (int c = 0; c < N; ++c)
+                entering[std::size_t(c)] |= std::uint32_t((columns >> (8 * c)) & 0xff) << (8 * group);
+        }
+        return entering;
     }
 
     // The 8x8 bit matrix whose row i is byte i of x, transposed (bit c of byte i becomes bit i

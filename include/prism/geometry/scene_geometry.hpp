@@ -963,21 +963,14 @@ private:
             }
             return hit;
         }
-        Unconstructed<Ray<Real>, index_lanes> local;
-        Unconstructed<TraversalRay, index_lanes> traversal;
-        Unconstructed<TriangleRay, index_lanes> triangle;
-        for (std::uint32_t rest = lanes; rest != 0; rest &= rest - 1) {
-            const std::size_t i = std::size_t(std::countr_zero(rest));
-            const Ray<Real>& ray = local.make(i, to_object(instance, rays[i]));
-            traversal.make(i, ray);
-            triangle.make(i, ray);
-        }
+        ObjectSpaceRays local;
+        local.make(*this, instance, rays, lanes);
         const Mesh& mesh = meshes_[instance.shape];
         return culls_back_faces(Culling, mesh.smooth())
-                   ? mesh.template intersect_lanes<true>(local.data(), traversal.data(), triangle.data(), t_min, t_max, lanes,
-                                                         hits, tied)
-                   : mesh.template intersect_lanes<false>(local.data(), traversal.data(), triangle.data(), t_min, t_max, lanes,
-                                                          hits, tied);
+                   ? mesh.template intersect_lanes<true>(local.ray.data(), local.traversal.data(), local.triangle.data(),
+                                                         t_min, t_max, lanes, hits, tied)
+                   : mesh.template intersect_lanes<false>(local.ray.data(), local.traversal.data(), local.triangle.data(),
+                                                          t_min, t_max, lanes, hits, tied);
     }
 
     // occluded_side_by_side in a scene traversed through its index (no direct form), for up to
@@ -1052,6 +1045,24 @@ private:
         return blocked;
     }
 
+    // The rays of `lanes` taken to an instance's object space and set up there, each as
+    // occludes and intersect_instance set up one (occludes_in_object_space,
+    // intersect_in_object_space).
+    struct ObjectSpaceRays {
+        Unconstructed<Ray<Real>, index_lanes> ray;
+        Unconstructed<TraversalRay, index_lanes> traversal;
+        Unconstructed<TriangleRay, index_lanes> triangle;
+
+        void make(const SceneGeometry& geometry, const Instance& instance, const Ray<Real>* rays, std::uint32_t lanes) {
+            for (; lanes != 0; lanes &= lanes - 1) {
+                const std::size_t i = std::size_t(std::countr_zero(lanes));
+                const Ray<Real>& local = ray.make(i, geometry.to_object(instance, rays[i]));
+                traversal.make(i, local);
+                triangle.make(i, local);
+            }
+        }
+    };
+
     // occludes for the rays of `lanes` and an object not in world space: each ray taken to
     // its object space and set up there as occludes does.
     std::uint32_t occludes_in_object_space(const Instance& instance, const Ray<Real>* rays, const Real* t_min,
@@ -1068,16 +1079,10 @@ private:
             }
             return blocked;
         }
-        Unconstructed<Ray<Real>, index_lanes> local;
-        Unconstructed<TraversalRay, index_lanes> traversal;
-        Unconstructed<TriangleRay, index_lanes> triangle;
-        for (std::uint32_t rest = lanes; rest != 0; rest &= rest - 1) {
-            const std::size_t i = std::size_t(std::countr_zero(rest));
-            const Ray<Real>& ray = local.make(i, to_object(instance, rays[i]));
-            traversal.make(i, ray);
-            triangle.make(i, ray);
-        }
-        return meshes_[instance.shape].occluded_lanes(local.data(), traversal.data(), triangle.data(), t_min, t_max, lanes);
+        ObjectSpaceRays local;
+        local.make(*this, instance, rays, lanes);
+        return meshes_[instance.shape].occluded_lanes(local.ray.data(), local.traversal.data(), local.triangle.data(), t_min,
+                                                      t_max, lanes);
     }
 
     // Whether the ray meets the box of a world-space index within its interval, by the same
