@@ -812,15 +812,10 @@ private:
         requires Mesh::packed
     {
         const std::uint32_t present = (std::uint32_t(1) << count) - 1;
-        Unconstructed<TraversalRay, index_lanes> traversal;
-        Unconstructed<TriangleRay, index_lanes> world_triangle;  // made for the lanes that first enter a world-space mesh
-        std::uint32_t made = 0;
-        alignas(64) Real t_min[index_lanes], t_max[index_lanes];
-        for (int i = 0; i < count; ++i) {
-            traversal.make(std::size_t(i), rays[i]);
-            t_min[i] = rays[i].t_min;
-            t_max[i] = rays[i].t_max;
-        }
+        WorldSpaceRays world(rays, count);
+        Real* const t_min = world.t_min;
+        Real* const t_max = world.t_max;
+        auto& traversal = world.traversal;
         std::uint32_t found = 0;
         for (const WorldMeshes& group : world_meshes_) {
             const Mesh& index = index_of(group);
@@ -831,11 +826,7 @@ private:
                 if (index.enters(traversal[std::size_t(i)], t_min[i], t_max[i])) lanes |= std::uint32_t(1) << i;
             }
             if (lanes == 0) continue;
-            for (std::uint32_t missing = lanes & ~made; missing != 0; missing &= missing - 1) {
-                const int i = std::countr_zero(missing);
-                world_triangle.make(std::size_t(i), rays[i]);
-            }
-            made |= lanes;
+            const TriangleRay* const world_triangle = world.triangles(lanes);
             // What a tied ray is traced again from.
             std::array<Real, index_lanes> t_before;
             Unconstructed<Hit<Real>, index_lanes> hit_before;
@@ -846,20 +837,20 @@ private:
             }
             std::uint32_t tied = 0;
             std::uint32_t group_hits =
-                cull ? index.template intersect_lanes<true>(rays, traversal.data(), world_triangle.data(), t_min, t_max, lanes,
-                                                            hits, tied)
-                     : index.template intersect_lanes<false>(rays, traversal.data(), world_triangle.data(), t_min, t_max,
-                                                             lanes, hits, tied);
+                cull ? index.template intersect_lanes<true>(rays, traversal.data(), world_triangle, t_min, t_max, lanes, hits,
+                                                            tied)
+                     : index.template intersect_lanes<false>(rays, traversal.data(), world_triangle, t_min, t_max, lanes, hits,
+                                                             tied);
             for (; tied != 0; tied &= tied - 1) {
                 const int i = std::countr_zero(tied);
                 const std::uint32_t bit = std::uint32_t(1) << i;
                 t_max[i] = t_before[std::size_t(i)];
                 hits[i] = hit_before[std::size_t(i)];
                 rays[i].t_max = t_max[i];
-                const bool hit = cull ? index.template intersect<true>(rays[i], traversal[std::size_t(i)], world_triangle[std::size_t(i)],
+                const bool hit = cull ? index.template intersect<true>(rays[i], traversal[std::size_t(i)], world_triangle[i],
                                                                        t_max[i], hits[i])
                                       : index.template intersect<false>(rays[i], traversal[std::size_t(i)],
-                                                                        world_triangle[std::size_t(i)], t_max[i], hits[i]);
+                                                                        world_triangle[i], t_max[i], hits[i]);
                 group_hits = hit ? group_hits | bit : group_hits & ~bit;
             }
             for (std::uint32_t rest = group_hits; rest != 0; rest &= rest - 1) {
@@ -900,17 +891,13 @@ private:
                     const Instance& instance = instances_[object];
                     std::uint32_t instance_hits = 0;
                     if (instance.kind == Kind::mesh && in_world_space(instance)) {
-                        for (std::uint32_t missing = testing & ~made; missing != 0; missing &= missing - 1) {
-                            const int i = std::countr_zero(missing);
-                            world_triangle.make(std::size_t(i), rays[i]);
-                        }
-                        made |= testing;
+                        const TriangleRay* const world_triangle = world.triangles(testing);
                         const Mesh& mesh = meshes_[instance.shape];
                         instance_hits = culls_back_faces(Culling, mesh.smooth())
-                                            ? mesh.template intersect_lanes<true>(rays, traversal.data(), world_triangle.data(),
-                                                                                  t_min, t_max, testing, hits, tied)
-                                            : mesh.template intersect_lanes<false>(rays, traversal.data(), world_triangle.data(),
-                                                                                   t_min, t_max, testing, hits, tied);
+                                            ? mesh.template intersect_lanes<true>(rays, traversal.data(), world_triangle, t_min,
+                                                                                  t_max, testing, hits, tied)
+                                            : mesh.template intersect_lanes<false>(rays, traversal.data(), world_triangle, t_min,
+                                                                                   t_max, testing, hits, tied);
                     } else {
                         instance_hits = intersect_in_object_space<Culling>(instance, rays, t_min, t_max, testing, hits, tied);
                     }
@@ -984,23 +971,10 @@ private:
         requires Mesh::packed
     {
         const std::uint32_t present = (std::uint32_t(1) << count) - 1;
-        Unconstructed<TraversalRay, index_lanes> traversal;
-        Unconstructed<TriangleRay, index_lanes> world_triangle;  // made for the lanes that first enter a world-space mesh
-        std::uint32_t made = 0;
-        alignas(64) Real t_min[index_lanes], t_max[index_lanes];
-        for (int i = 0; i < count; ++i) {
-            traversal.make(std::size_t(i), rays[i]);
-            t_min[i] = rays[i].t_min;
-            t_max[i] = rays[i].t_max;
-        }
-        const auto world_triangle_rays = [&](std::uint32_t lanes) {
-            for (std::uint32_t missing = lanes & ~made; missing != 0; missing &= missing - 1) {
-                const int i = std::countr_zero(missing);
-                world_triangle.make(std::size_t(i), rays[i]);
-            }
-            made |= lanes;
-            return world_triangle.data();
-        };
+        WorldSpaceRays world(rays, count);
+        const Real* const t_min = world.t_min;
+        const Real* const t_max = world.t_max;
+        auto& traversal = world.traversal;
         std::uint32_t blocked = 0;
         for (const WorldMeshes& group : world_meshes_) {
             const Mesh& index = index_of(group);
@@ -1010,7 +984,7 @@ private:
                 if (index.enters(traversal[std::size_t(i)], t_min[i], t_max[i])) lanes |= std::uint32_t(1) << i;
             }
             if (lanes == 0) continue;
-            blocked |= index.occluded_lanes(rays, traversal.data(), world_triangle_rays(lanes), t_min, t_max, lanes);
+            blocked |= index.occluded_lanes(rays, traversal.data(), world.triangles(lanes), t_min, t_max, lanes);
         }
         if (direct_top_) {
             for (std::uint32_t rest = present & ~blocked; rest != 0; rest &= rest - 1) {
@@ -1029,7 +1003,7 @@ private:
                         const Instance& instance = instances_[top_objects_[order[k]]];
                         const std::uint32_t lanes = testing & ~hit;
                         if (instance.kind == Kind::mesh && in_world_space(instance)) {
-                            hit |= meshes_[instance.shape].occluded_lanes(rays, traversal.data(), world_triangle_rays(lanes),
+                            hit |= meshes_[instance.shape].occluded_lanes(rays, traversal.data(), world.triangles(lanes),
                                                                           t_min, t_max, lanes);
                             continue;
                         }
@@ -1060,6 +1034,35 @@ private:
                 traversal.make(i, local);
                 triangle.make(i, local);
             }
+        }
+    };
+
+    // The world-space set-up of up to index_lanes rays, each as intersect and occluded make it
+    // for one: its traversal set-up and its t range, and its triangle set-up once it first
+    // enters a world-space mesh (triangles).
+    struct WorldSpaceRays {
+        const Ray<Real>* rays;
+        Unconstructed<TraversalRay, index_lanes> traversal;
+        Unconstructed<TriangleRay, index_lanes> triangle;
+        std::uint32_t made = 0;  // the lanes whose triangle set-up is made
+        alignas(64) Real t_min[index_lanes];
+        alignas(64) Real t_max[index_lanes];
+
+        WorldSpaceRays(const Ray<Real>* rays_, int count) : rays(rays_) {
+            for (int i = 0; i < count; ++i) {
+                traversal.make(std::size_t(i), rays[i]);
+                t_min[i] = rays[i].t_min;
+                t_max[i] = rays[i].t_max;
+            }
+        }
+        // The triangle set-ups, made for the lanes of `lanes` that have none yet.
+        const TriangleRay* triangles(std::uint32_t lanes) {
+            for (std::uint32_t missing = lanes & ~made; missing != 0; missing &= missing - 1) {
+                const int i = std::countr_zero(missing);
+                triangle.make(std::size_t(i), rays[i]);
+            }
+            made |= lanes;
+            return triangle.data();
         }
     };
 
