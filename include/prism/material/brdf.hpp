@@ -74,6 +74,9 @@ template <Scalar Real, class Model>
 Real mixture_pdf(const Model& model, Real lobe_weight, const Vec3<Real>& n, const Vec3<Real>& wi,
                  const Vec3<Real>& wo) {
     const Real cosine = std::max(glm::dot(n, wi), Real(0)) / pi<Real>;
+    // Without a specular term the lobe is never drawn (weight 0), and its density (a power) is
+    // left out: 0 times a finite, non-negative density is the +0 added here, the same bits.
+    if (lobe_weight == 0) return (1 - lobe_weight) * cosine + Real(0);
     return (1 - lobe_weight) * cosine + lobe_weight * model.lobe().pdf(n, wi, wo);
 }
 

@@ -107,7 +107,7 @@ private:
                 color += throughput * escaped(ray.direction, depth, count_emission, path.pixel_uv);
                 break;
             }
-            SurfacePoint<Real> point = geometry_.surface(ray, hit);
+            SurfacePoint<Real> point = shading_surface(geometry_, textures_, ray, hit, settings_.ray_offset);
             Material<Real> material = materials_[point.material];
             travelled += hit.t;
             const RayCone<Real> cone{travelled * path.spread, std::abs(glm::dot(ray.direction, point.shading_normal))};

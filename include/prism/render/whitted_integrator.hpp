@@ -99,6 +99,20 @@ template <bool Textured, Scalar Real, class Geometry>
         return geometry.surface(ray, hit);
 }
 
+// The same for an integrator's texture set: a renderer compiled with textures parametrises its
+// surfaces only when the scene has some. Without, nothing reads (u, v) or the tangents, and a
+// sphere's (its acos, atan2 and sincos) were 4% of hw7 path_glass's time in the renderer that
+// every path-traced scene takes (all features compiled in).
+template <class Textures, Scalar Real, class Geometry>
+[[gnu::always_inline]] inline SurfacePoint<Real> shading_surface(const Geometry& geometry, const Textures& textures,
+                                                                 const Ray<Real>& ray, const Hit<Real>& hit,
+                                                                 RayOffset offset) {
+    if constexpr (textured<Textures, Real>) {
+        if (!textures.empty()) return shading_surface<true>(geometry, ray, hit, offset);
+    }
+    return shading_surface<false>(geometry, ray, hit, offset);
+}
+
 // What escaping rays see, for renderers without environment lights: the background colour for
 // primary rays, nothing for the others.
 template <Scalar Real>
@@ -249,7 +263,7 @@ public:
             }
             const Ray<Real>& ray = rays[i];
             PrelitPoint& at = points.make_from(std::size_t(i), [&] {
-                return PrelitPoint{shading_surface<textured<Textures, Real>>(geometry_, ray, hits[i], settings_.ray_offset)};
+                return PrelitPoint{shading_surface(geometry_, textures_, ray, hits[i], settings_.ray_offset)};
             });
             if constexpr (textured<Textures, Real>) copies.make(std::size_t(i), materials_[at.point.material]);
             at.travelled = Real(0) + hits[i].t;
@@ -629,7 +643,7 @@ private:
     // intersection.
     [[gnu::always_inline]] Vec3<Real> shade(const Ray<Real>& ray, const Hit<Real>& hit, int depth, CameraPath& path,
                                             Real travelled) const {
-        SurfacePoint<Real> point = shading_surface<textured<Textures, Real>>(geometry_, ray, hit, settings_.ray_offset);
+        SurfacePoint<Real> point = shading_surface(geometry_, textures_, ray, hit, settings_.ray_offset);
         // Textures change a copy; without them the material is read where it is stored.
         std::conditional_t<textured<Textures, Real>, Material<Real>, const Material<Real>&> material =
             materials_[point.material];

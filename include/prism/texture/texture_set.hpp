@@ -121,8 +121,18 @@ public:
     // integrator uses it as the point's radiance instead of shading.
     // `cone` sets the level of detail of trilinear textures (see MipMap::level_of_detail); the
     // default reads the finest level.
-    std::optional<Vec3<Real>> apply(SurfacePoint<Real>& point, Material<Real>& material,
-                                    const RayCone<Real>& cone = {}) const {
+    // A point without textures returns at once, inlined into the integrator: out of line, the
+    // call alone (its frame set up for the texture lookups) was 3.3-3.9% of hw7 path_diffuse's
+    // and path_glass's time, scenes with no texture at all.
+    [[gnu::always_inline]] std::optional<Vec3<Real>> apply(SurfacePoint<Real>& point, Material<Real>& material,
+                                                           const RayCone<Real>& cone = {}) const {
+        if (point.textures.empty()) return {};
+        return apply_textures(point, material, cone);
+    }
+
+private:
+    std::optional<Vec3<Real>> apply_textures(SurfacePoint<Real>& point, Material<Real>& material,
+                                             const RayCone<Real>& cone) const {
         std::optional<Vec3<Real>> unshaded;
         for (const std::uint32_t index : point.textures) {
             const Entry& texture = textures_[index];
@@ -141,6 +151,7 @@ public:
         return unshaded;
     }
 
+public:
     // The replace_background texture at a pixel's (u, v) = ((x + 0.5) / width, (y + 0.5) / height)
     // from the top-left corner, in the renderer's radiance units (0..255 is the PNG's range, so
     // an 8-bit image with the default Normalizer shows as stored); nothing without one.

@@ -22,7 +22,7 @@ struct ModifiedBlinnPhong {
                         const Vec3<Real>& wo) const {
         if (glm::dot(n, wi) <= 0) return Vec3<Real>(0);
         const Vec3<Real> half = unit_vector(wi + wo);
-        const Real specular = std::pow(std::max(glm::dot(n, half), Real(0)), exponent);
+        const Real specular = specular_power(ks, std::max(glm::dot(n, half), Real(0)), exponent);
         if (!normalized) return kd + ks * specular;
         return kd / pi<Real> + ks * ((exponent + 8) / (8 * pi<Real>) * specular);
     }

@@ -22,7 +22,7 @@ struct ModifiedPhong {
                         const Vec3<Real>& wo) const {
         if (glm::dot(n, wi) <= 0) return Vec3<Real>(0);
         const Real cos_alpha = std::max(glm::dot(mirrored(wi, n), wo), Real(0));
-        const Real specular = std::pow(cos_alpha, exponent);
+        const Real specular = specular_power(ks, cos_alpha, exponent);
         if (!normalized) return kd + ks * specular;
         return kd / pi<Real> + ks * ((exponent + 2) / (2 * pi<Real>) * specular);
     }

@@ -21,7 +21,7 @@ struct OriginalBlinnPhong {
         if (cos_incident <= 0) return Vec3<Real>(0);
         const Vec3<Real> half = unit_vector(wi + wo);
         const Real cos_alpha = std::max(glm::dot(n, half), Real(0));
-        return kd + ks * (std::pow(cos_alpha, exponent) / cos_incident);
+        return kd + ks * (specular_power(ks, cos_alpha, exponent) / cos_incident);
     }
     BlinnLobe<Real> lobe() const { return {exponent}; }
 };

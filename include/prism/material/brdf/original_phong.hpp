@@ -21,7 +21,7 @@ struct OriginalPhong {
         const Real cos_incident = glm::dot(n, wi);
         if (cos_incident <= 0) return Vec3<Real>(0);
         const Real cos_alpha = std::max(glm::dot(mirrored(wi, n), wo), Real(0));
-        return kd + ks * (std::pow(cos_alpha, exponent) / cos_incident);
+        return kd + ks * (specular_power(ks, cos_alpha, exponent) / cos_incident);
     }
     PhongLobe<Real> lobe() const { return {exponent}; }
 };
