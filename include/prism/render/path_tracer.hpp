@@ -77,10 +77,48 @@ public:
 
     Vec3<Real> radiance(const Ray<Real>& ray, CameraPath& path) const {
         if (!path.renderer.path_tracing) {
-            typename RayTracer::CameraPath traced{path.random, path.pixel_uv, path.spread};
+            typename RayTracer::CameraPath traced = ray_traced(path);
             return whitted_.radiance(ray, traced);
         }
-        return trace(ray, path);
+        return trace(ray, path, nullptr, false);
+    }
+
+    // Camera rays several at a time, as the ray tracer takes them (WhittedIntegrator: their
+    // closest hits first, then each ray's radiance from its hit), for the cameras of both
+    // integrators. A path's camera hit is the one its own first intersection finds (the same
+    // culling rule, intersect_each's hits are intersect's), and the path goes on from it with
+    // the same draws: the same bits. Without these, a path-traced scene's ray-traced cameras
+    // lost the ray tracer's batches (hw7 VeachAjar's first camera), and its paths' camera rays,
+    // a pixel's samples side by side, went through the index one at a time.
+    bool batches_camera_rays() const { return whitted_.batches_camera_rays(); }
+    std::uint32_t camera_hits(Ray<Real>* rays, Hit<Real>* hits, int count) const
+        requires requires(const RayTracer& ray_tracer) { ray_tracer.camera_hits(rays, hits, count); }
+    {
+        return whitted_.camera_hits(rays, hits, count);
+    }
+    Vec3<Real> radiance_at(const Ray<Real>& ray, const Hit<Real>& hit, bool found, CameraPath& path) const {
+        if (!path.renderer.path_tracing) {
+            typename RayTracer::CameraPath traced = ray_traced(path);
+            return whitted_.radiance_at(ray, hit, found, traced);
+        }
+        return trace(ray, path, &hit, found);
+    }
+    // A pixel's samples from their camera hits: the ray tracer's side-by-side shadow rays for a
+    // ray-traced camera; a path-traced camera's paths one after another, each from its hit.
+    static constexpr int prelit_width = RayTracer::prelit_width;
+    bool prelights() const { return whitted_.prelights(); }
+    void radiances_at(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count, CameraPath& path,
+                      Vec3<Real>* radiance) const
+        requires requires(const RayTracer& ray_tracer, typename RayTracer::CameraPath& traced) {
+            ray_tracer.radiances_at(rays, hits, found, count, traced, radiance);
+        }
+    {
+        if (!path.renderer.path_tracing) {
+            typename RayTracer::CameraPath traced = ray_traced(path);
+            whitted_.radiances_at(rays, hits, found, count, traced, radiance);
+            return;
+        }
+        for (int i = 0; i < count; ++i) radiance[i] = trace(rays[i], path, &hits[i], (found >> i) & 1);
     }
 
 private:
@@ -89,7 +127,13 @@ private:
         std::uint32_t index = 0;
     };
 
-    Vec3<Real> trace(Ray<Real> ray, CameraPath& path) const {
+    static typename RayTracer::CameraPath ray_traced(CameraPath& path) {
+        return {path.random, path.pixel_uv, path.spread};
+    }
+
+    // The path from a camera ray; `camera_hit` (with `camera_found`): its closest hit, found
+    // already (camera_hits), or null to find it here.
+    Vec3<Real> trace(Ray<Real> ray, CameraPath& path, const Hit<Real>* camera_hit, bool camera_found) const {
         const scene::RendererParams& params = path.renderer;
         Random& random = path.random;
         Vec3<Real> color(0), throughput(1);
@@ -102,7 +146,13 @@ private:
         Real travelled = 0;
         for (int depth = 0;; ++depth) {
             Hit<Real> hit;
-            const bool found = intersect(ray, depth, hit);
+            bool found;
+            if (depth == 0 && camera_hit) {
+                found = camera_found;
+                if (found) hit = *camera_hit;
+            } else {
+                found = intersect(ray, depth, hit);
+            }
             if (!found) {
                 color += throughput * escaped(ray.direction, depth, count_emission, path.pixel_uv);
                 break;
