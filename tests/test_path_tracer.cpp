@@ -10,6 +10,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstring>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -190,6 +191,95 @@ TEST_CASE_TEMPLATE("PathTracer: every RendererParams combination converges to th
             CHECK(reference.mean[b] > 0.01);
             const double noise = std::sqrt(reference.error[b] * reference.error[b] + other.error[b] * other.error[b]);
             CHECK(std::abs(other.mean[b] - reference.mean[b]) <= 4.5 * noise + 1e-6);
+        }
+    }
+}
+
+TEST_CASE_TEMPLATE("PathTracer: camera rays through the batch entries give each pixel the one-by-one trace's bits",
+                   Real, float, double) {
+    // Renderer hands camera rays to the integrator several at a time: their closest hits first
+    // (camera_hits), then each path from its hit (radiance_row for a row of one-sample pixels,
+    // radiance_at and radiances_at for a pixel's samples). The reference is the integrator's own
+    // radiance, ray by ray on each pixel's stream, summed with the filter weights as the
+    // Renderer sums them: every pixel's bits must agree, for path-traced cameras under several
+    // RendererParams and for a ray-traced camera in the same renderer. The wide BVH batches the
+    // hits (intersect_each through the index of the box and a 128-triangle ridged floor).
+    TemporaryFolder folder;
+    scene::Scene world = prism::io::load_scene(folder.write("cornell.xml", cornell_xml));
+    world.point_lights.push_back({"bulb", {0.2, 0.6, 0.3}, {2, 2, 2}});
+    scene::Mesh ridges;
+    ridges.material = 0;
+    constexpr int cells = 8;
+    for (int z = 0; z <= cells; ++z)
+        for (int x = 0; x <= cells; ++x)
+            ridges.positions.push_back({-0.9 + 1.8 * x / cells, -0.95 + 0.04 * ((x + z) % 2), -0.9 + 1.8 * z / cells});
+    for (int z = 0; z < cells; ++z)
+        for (int x = 0; x < cells; ++x) {
+            const std::uint32_t a = std::uint32_t(z * (cells + 1) + x), b = a + 1, c = a + cells + 1, d = c + 1;
+            ridges.triangles.push_back({a, c, b});
+            ridges.triangles.push_back({b, c, d});
+        }
+    world.meshes.push_back(ridges);
+    using Batched = prism::Config<Real, prism::WideBvh<prism::Watertight, 8>, prism::AllLightSet, prism::all_features,
+                                  prism::PathTracer>;
+    using Whole = prism::Renderer<Batched>;
+    const prism::RendererSettings settings{prism::BackfaceCulling::flat_triangles, prism::RayOffset::scene_epsilon, 3};
+    const Whole renderer(world, settings);
+    const typename Whole::Geometry geometry(world);
+    const typename Whole::LightSetT lights(world);
+    std::vector<prism::Material<Real>> materials;
+    for (const scene::Material& material : world.materials) materials.emplace_back(material);
+    const typename Whole::TexturesT textures(world);
+    const typename Whole::EnvironmentT environment(*lights.template of_type<prism::EnvironmentLight>());
+    const typename Whole::Integrator integrator(geometry, lights, materials, textures, environment,
+                                                prism::Vec3<Real>(world.ambient_light),
+                                                prism::Vec3<Real>(world.background_color),
+                                                prism::IntegratorSettings{world.max_recursion_depth,
+                                                                          world.shadow_ray_epsilon, settings.ray_offset,
+                                                                          settings.backface_culling});
+    REQUIRE(integrator.batches_camera_rays());
+    std::vector<scene::RendererParams> cameras = {{true, true, true, true, true}, {true, false, false, false, false},
+                                                  {true, true, false, true, false}, {}};
+    for (const scene::RendererParams& params : cameras) {
+        for (const int count : {1, 5, 40}) {
+            CAPTURE(describe(params));
+            CAPTURE(params.path_tracing);
+            CAPTURE(count);
+            scene::Camera camera = world.cameras[0];
+            camera.width = camera.height = 12;
+            camera.renderer = params;
+            camera.num_samples = count;
+            const prism::Image image = renderer.render(camera);
+            const prism::ThinLensCamera<Real> lens(camera, camera.width, camera.height);
+            std::vector<prism::CameraSample<Real>> samples;
+            std::vector<prism::Vec2<Real>> strata;
+            int mismatches = 0;
+            double total = 0;
+            for (int y = 0; y < camera.height; ++y)
+                for (int x = 0; x < camera.width; ++x) {
+                    prism::Random random = prism::Random::for_pixel(x, y, settings.seed);
+                    typename Whole::Integrator::CameraPath path{
+                        random,
+                        prism::Vec2<Real>((Real(x) + Real(0.5)) / Real(camera.width),
+                                          (Real(y) + Real(0.5)) / Real(camera.height)),
+                        lens.pixel_spread(), params};
+                    if (count == 1) samples = {prism::centre_sample<Real>(random)};
+                    else prism::camera_samples(count, random, samples, strata);
+                    prism::Vec3<Real> sum(0);
+                    Real weights = 0;
+                    for (const prism::CameraSample<Real>& sample : samples) {
+                        const prism::Ray<Real> ray =
+                            lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time);
+                        const Real weight = count == 1 ? Real(1) : prism::filter_weight(camera.filter, sample.pixel);
+                        sum += weight * integrator.radiance(ray, path);
+                        weights += weight;
+                    }
+                    const glm::vec3 expected(sum / weights);
+                    mismatches += std::memcmp(&expected, &image(x, y), sizeof expected) != 0;
+                    total += expected.r + expected.g + expected.b;
+                }
+            CHECK(mismatches == 0);
+            CHECK(total > 0);
         }
     }
 }

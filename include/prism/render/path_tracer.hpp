@@ -91,9 +91,7 @@ public:
     // lost the ray tracer's batches (hw7 VeachAjar's first camera), and its paths' camera rays,
     // a pixel's samples side by side, went through the index one at a time.
     bool batches_camera_rays() const { return whitted_.batches_camera_rays(); }
-    std::uint32_t camera_hits(Ray<Real>* rays, Hit<Real>* hits, int count) const
-        requires requires(const RayTracer& ray_tracer) { ray_tracer.camera_hits(rays, hits, count); }
-    {
+    std::uint32_t camera_hits(Ray<Real>* rays, Hit<Real>* hits, int count) const {
         return whitted_.camera_hits(rays, hits, count);
     }
     Vec3<Real> radiance_at(const Ray<Real>& ray, const Hit<Real>& hit, bool found, CameraPath& path) const {
@@ -103,16 +101,23 @@ public:
         }
         return trace(ray, path, &hit, found);
     }
+    // A row's pixels of one sample from their camera hits, one after another (the ray tracer's
+    // rows shade point lights alone, and this renderer holds every light type).
+    static constexpr int row_width = RayTracer::row_width;
+    template <class MakePath>
+    void radiance_row(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count, MakePath make_path,
+                      Vec3<Real>* radiance) const {
+        for (int i = 0; i < count; ++i) {
+            CameraPath path = make_path(i);
+            radiance[i] = radiance_at(rays[i], hits[i], (found >> i) & 1, path);
+        }
+    }
     // A pixel's samples from their camera hits: the ray tracer's side-by-side shadow rays for a
     // ray-traced camera; a path-traced camera's paths one after another, each from its hit.
     static constexpr int prelit_width = RayTracer::prelit_width;
     bool prelights() const { return whitted_.prelights(); }
     void radiances_at(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count, CameraPath& path,
-                      Vec3<Real>* radiance) const
-        requires requires(const RayTracer& ray_tracer, typename RayTracer::CameraPath& traced) {
-            ray_tracer.radiances_at(rays, hits, found, count, traced, radiance);
-        }
-    {
+                      Vec3<Real>* radiance) const {
         if (!path.renderer.path_tracing) {
             typename RayTracer::CameraPath traced = ray_traced(path);
             whitted_.radiances_at(rays, hits, found, count, traced, radiance);

@@ -149,33 +149,19 @@ private:
                         lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time));
                 }
             }
-            // Where the integrator can (batches_camera_rays), the row's closest hits first, then
-            // its shading: the row's shadow rays side by side too where it can (radiance_row),
-            // else ray by ray from each hit.
-            if constexpr (requires { integrator_.camera_hits(rays.data(), (Hit<Real>*)nullptr, n); }) {
-                if (integrator_.batches_camera_rays()) {
-                    std::array<Hit<Real>, batch> hits;
-                    const std::uint32_t found = integrator_.camera_hits(rays.data(), hits.data(), n);
-                    const auto make_path = [&](int i) {
-                        return camera_path(lens, camera, spread, streams[std::size_t(i)], start + i, y);
-                    };
-                    if constexpr (requires(std::array<Vec3<Real>, batch> radiance) {
-                                      integrator_.radiance_row(rays.data(), hits.data(), found, n, make_path, radiance.data());
-                                  }) {
-                        static_assert(Integrator::row_width >= batch);
-                        std::array<Vec3<Real>, batch> radiance;
-                        integrator_.radiance_row(rays.data(), hits.data(), found, n, make_path, radiance.data());
-                        for (int i = 0; i < n; ++i) image(start + i, y) = one_sample_pixel(radiance[std::size_t(i)]);
-                        continue;
-                    }
-                    for (int i = 0; i < n; ++i) {
-                        const int x = start + i;
-                        typename Integrator::CameraPath path = camera_path(lens, camera, spread, streams[std::size_t(i)], x, y);
-                        image(x, y) = one_sample_pixel(integrator_.radiance_at(rays[std::size_t(i)], hits[std::size_t(i)],
-                                                                               (found >> i) & 1, path));
-                    }
-                    continue;
-                }
+            // Where the integrator batches camera rays, the row's closest hits first, then its
+            // shading (radiance_row: the row's shadow rays side by side where the integrator can).
+            if (integrator_.batches_camera_rays()) {
+                static_assert(Integrator::row_width >= batch);
+                std::array<Hit<Real>, batch> hits;
+                const std::uint32_t found = integrator_.camera_hits(rays.data(), hits.data(), n);
+                const auto make_path = [&](int i) {
+                    return camera_path(lens, camera, spread, streams[std::size_t(i)], start + i, y);
+                };
+                std::array<Vec3<Real>, batch> radiance;
+                integrator_.radiance_row(rays.data(), hits.data(), found, n, make_path, radiance.data());
+                for (int i = 0; i < n; ++i) image(start + i, y) = one_sample_pixel(radiance[std::size_t(i)]);
+                continue;
             }
             for (int i = 0; i < n; ++i) {
                 const int x = start + i;
@@ -223,43 +209,36 @@ private:
         // from its hit, in the samples' order: the hits radiance's own intersection finds and
         // the same draws, so the same sum. The traversals then follow one another without a
         // shading in between (hw4 VeachAjar's 16 samples a pixel).
-        if constexpr (requires { integrator_.camera_hits(scratch.rays.data(), (Hit<Real>*)nullptr, 1); }) {
-            if (integrator_.batches_camera_rays()) {
-                constexpr std::size_t batch = 32;
-                Unconstructed<Hit<Real>, batch> hits;
-                for (std::size_t first = 0; first < n; first += batch) {
-                    const int count = int(std::min(batch, n - first));
-                    Ray<Real>* const rays = scratch.rays.data() + first;
-                    const std::uint32_t found = integrator_.camera_hits(rays, hits.data(), count);
-                    // Where the integrator samples the lights that draw nothing for several
-                    // samples first (radiances_at), their shadow rays go side by side.
-                    if constexpr (requires(Vec3<Real>* radiance) {
-                                      integrator_.radiances_at(rays, hits.data(), found, count, path, radiance);
-                                  }) {
-                        if (integrator_.prelights()) {
-                            constexpr int width = Integrator::prelit_width;
-                            std::array<Vec3<Real>, width> radiance;
-                            for (int part = 0; part < count; part += width) {
-                                const int n = std::min(width, count - part);
-                                integrator_.radiances_at(rays + part, hits.data() + part, found >> part, n, path,
-                                                         radiance.data());
-                                for (int i = 0; i < n; ++i) {
-                                    const Real weight = scratch.weights[first + std::size_t(part + i)];
-                                    sum += weight * radiance[std::size_t(i)];
-                                    weights += weight;
-                                }
-                            }
-                            continue;
+        if (integrator_.batches_camera_rays()) {
+            constexpr std::size_t batch = 32;
+            Unconstructed<Hit<Real>, batch> hits;
+            for (std::size_t first = 0; first < n; first += batch) {
+                const int count = int(std::min(batch, n - first));
+                Ray<Real>* const rays = scratch.rays.data() + first;
+                const std::uint32_t found = integrator_.camera_hits(rays, hits.data(), count);
+                // Where the integrator samples the lights that draw nothing for several samples
+                // first (prelights), their shadow rays go side by side.
+                if (integrator_.prelights()) {
+                    constexpr int width = Integrator::prelit_width;
+                    std::array<Vec3<Real>, width> radiance;
+                    for (int part = 0; part < count; part += width) {
+                        const int n = std::min(width, count - part);
+                        integrator_.radiances_at(rays + part, hits.data() + part, found >> part, n, path, radiance.data());
+                        for (int i = 0; i < n; ++i) {
+                            const Real weight = scratch.weights[first + std::size_t(part + i)];
+                            sum += weight * radiance[std::size_t(i)];
+                            weights += weight;
                         }
                     }
-                    for (int i = 0; i < count; ++i) {
-                        const Real weight = scratch.weights[first + std::size_t(i)];
-                        sum += weight * integrator_.radiance_at(rays[i], hits[std::size_t(i)], (found >> i) & 1, path);
-                        weights += weight;
-                    }
+                    continue;
                 }
-                return glm::vec3(sum / weights);
+                for (int i = 0; i < count; ++i) {
+                    const Real weight = scratch.weights[first + std::size_t(i)];
+                    sum += weight * integrator_.radiance_at(rays[i], hits[std::size_t(i)], (found >> i) & 1, path);
+                    weights += weight;
+                }
             }
+            return glm::vec3(sum / weights);
         }
         for (std::size_t i = 0; i < n; ++i) {
             sum += scratch.weights[i] * integrator_.radiance(scratch.rays[i], path);

@@ -177,16 +177,23 @@ public:
         if constexpr (requires { geometry_.intersection_batches(); }) return true;
         else return false;
     }
-    std::uint32_t camera_hits(Ray<Real>* rays, Hit<Real>* hits, int count) const
-        requires requires(const Geometry& geometry) { geometry.template intersect_each<BackfaceCulling::none>(rays, hits, count); }
-    {
-        switch (settings_.backface_culling) {
-            case BackfaceCulling::none: break;
-            case BackfaceCulling::flat_triangles:
-                return geometry_.template intersect_each<BackfaceCulling::flat_triangles>(rays, hits, count);
-            case BackfaceCulling::all: return geometry_.template intersect_each<BackfaceCulling::all>(rays, hits, count);
+    // Under another geometry (an outside index: accel/embree.hpp), which batches nothing, the
+    // rays are intersected one by one.
+    std::uint32_t camera_hits(Ray<Real>* rays, Hit<Real>* hits, int count) const {
+        if constexpr (!requires { geometry_.template intersect_each<BackfaceCulling::none>(rays, hits, count); }) {
+            std::uint32_t found = 0;
+            for (int i = 0; i < count; ++i)
+                if (intersect_culled(geometry_, settings_.backface_culling, 0, rays[i], hits[i])) found |= std::uint32_t(1) << i;
+            return found;
+        } else {
+            switch (settings_.backface_culling) {
+                case BackfaceCulling::none: break;
+                case BackfaceCulling::flat_triangles:
+                    return geometry_.template intersect_each<BackfaceCulling::flat_triangles>(rays, hits, count);
+                case BackfaceCulling::all: return geometry_.template intersect_each<BackfaceCulling::all>(rays, hits, count);
+            }
+            return geometry_.template intersect_each<BackfaceCulling::none>(rays, hits, count);
         }
-        return geometry_.template intersect_each<BackfaceCulling::none>(rays, hits, count);
     }
     Vec3<Real> radiance_at(const Ray<Real>& ray, const Hit<Real>& hit, bool found, CameraPath& path) const {
         if (!found) return escaped(ray.direction, 0, path.pixel_uv);
@@ -200,24 +207,29 @@ public:
     // then go on as a row of their own (shade_row). The same draws, rays, tests and sums as
     // radiance_at, so the same bits. `make_path(i)`: ray i's CameraPath (its pixel's stream,
     // by reference).
+    // Other renderers (textures, other lights, an outside index) take the rays one by one.
     static constexpr int row_width = 16;
     static constexpr std::size_t row_lights = 8;
+    static constexpr bool shades_rows =
+        !textured<Textures, Real> && std::is_same_v<LightSetT, LightSet<Real, PointLight>> &&
+        requires(const Geometry& geometry, const Ray<Real>* rays) { geometry.occluded_side_by_side(rays, 1); };
     template <class MakePath>
-        requires(!textured<Textures, Real> && std::is_same_v<LightSetT, LightSet<Real, PointLight>> &&
-                 requires(const Geometry& geometry, const Ray<Real>* rays) { geometry.occluded_side_by_side(rays, 1); })
     void radiance_row(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count, MakePath make_path,
                       Vec3<Real>* radiance) const {
-        const std::vector<PointLight<Real>>& lights = *lights_.template of_type<PointLight>();
-        if (lights.size() > row_lights) {
+        const std::vector<PointLight<Real>>* lights = nullptr;
+        if constexpr (shades_rows) lights = lights_.template of_type<PointLight>();
+        if (!lights || lights->size() > row_lights) {
             for (int i = 0; i < count; ++i) {
                 CameraPath path = make_path(i);
                 radiance[i] = radiance_at(rays[i], hits[i], (found >> i) & 1, path);
             }
             return;
         }
-        Unconstructed<CameraPath, row_width> paths;
-        for (int i = 0; i < count; ++i) paths.make_from(std::size_t(i), [&] { return make_path(i); });
-        shade_row<true>(rays, hits, found, count, paths.data(), nullptr, 0, radiance);
+        if constexpr (shades_rows) {
+            Unconstructed<CameraPath, row_width> paths;
+            for (int i = 0; i < count; ++i) paths.make_from(std::size_t(i), [&] { return make_path(i); });
+            shade_row<true>(rays, hits, found, count, paths.data(), nullptr, 0, radiance);
+        }
     }
 
     // radiance_at for `count` (<= prelit_width) camera rays of one pixel's samples, which
@@ -234,8 +246,19 @@ public:
     static_assert(prelit_width == row_width, "radiances_at makes point lights' rays as rows do (light_lanes)");
     static constexpr std::size_t prelit_lights = 8;
     bool prelights() const { return prelit_count_ > 0; }
+    // Under an outside index, which has no side-by-side shadow rays, the samples one by one.
     void radiances_at(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count, CameraPath& path,
-                      Vec3<Real>* radiance) const
+                      Vec3<Real>* radiance) const {
+        if constexpr (requires(const Ray<Real>* shadows) { geometry_.occluded_side_by_side(shadows, 1); })
+            prelit_radiances(rays, hits, found, count, path, radiance);
+        else
+            for (int i = 0; i < count; ++i) radiance[i] = radiance_at(rays[i], hits[i], (found >> i) & 1, path);
+    }
+
+private:
+    // radiances_at under prism's own geometry.
+    void prelit_radiances(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count, CameraPath& path,
+                          Vec3<Real>* radiance) const
         requires requires(const Geometry& geometry, const Ray<Real>* shadows) { geometry.occluded_side_by_side(shadows, 1); }
     {
         // shade's state at a camera hit up to its direct lighting (the point made in place).
@@ -369,7 +392,6 @@ public:
         }
     }
 
-private:
     // The light types sampled without a draw (sample(at) alone).
     template <class L>
     static constexpr bool draws_nothing = requires(const L& light, const ShadingFrame<Real>& at) { light.sample(at); };
