@@ -204,9 +204,9 @@ SceneResult measure_scene(const ChartScene& chart_scene, const Options& options)
     const auto reference_start = Clock::now();
     const prism::scene::Camera half =
         variant_camera(camera, variants()[reference_variant], std::max(1, options.reference_samples / 2));
-    const ChartRenderer first(scene, prism::RendererSettings{prism::BackfaceCulling::flat_triangles,
+    const ChartRenderer first(scene, prism::RendererSettings{prism::BackfaceCulling::triangles,
                                                               prism::RayOffset::scene_epsilon, 1});
-    const ChartRenderer second(scene, prism::RendererSettings{prism::BackfaceCulling::flat_triangles,
+    const ChartRenderer second(scene, prism::RendererSettings{prism::BackfaceCulling::triangles,
                                                                prism::RayOffset::scene_epsilon, 2});
     const prism::Image a = first.render(half, result.width, result.height);
     const prism::Image b = second.render(half, result.width, result.height);
@@ -220,7 +220,7 @@ SceneResult measure_scene(const ChartScene& chart_scene, const Options& options)
               << std::setprecision(1) << result.reference_seconds << " s wall, own relative RMSE "
               << std::setprecision(5) << result.reference_error << std::defaultfloat << "\n";
 
-    const ChartRenderer renderer(scene, prism::RendererSettings{prism::BackfaceCulling::flat_triangles,
+    const ChartRenderer renderer(scene, prism::RendererSettings{prism::BackfaceCulling::triangles,
                                                                  prism::RayOffset::scene_epsilon, 0});
     const std::size_t count = variants().size();
     result.points.assign(count, std::vector<Point>(options.samples.size()));

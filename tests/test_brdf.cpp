@@ -202,6 +202,53 @@ TEST_CASE_TEMPLATE("BRDFs: Torrance-Sparrow's D, F and G at two hand-worked conf
     }
 }
 
+TEST_CASE_TEMPLATE("BRDFs: Torrance-Sparrow of a conductor takes F from its absorption index, by hand", Real, float,
+                   double) {
+    // Issue 30's held-out hw6 sphere: kdfresnel="false", p = 50, the hw6 spheres' kd and ks,
+    // RefractionIndex 0.370 and AbsorptionIndex 2.820 (gold). F is the course's conductor
+    // Fresnel at beta, the angle between wo and h:
+    //     rs = (n^2 + k^2 - 2 n cos + cos^2) / (n^2 + k^2 + 2 n cos + cos^2),
+    //     rp = ((n^2 + k^2) cos^2 - 2 n cos + 1) / ((n^2 + k^2) cos^2 + 2 n cos + 1), F = (rs + rp) / 2,
+    // with n^2 + k^2 = 0.1369 + 7.9524 = 8.0893:
+    // - mirror configuration at 30 degrees (h = n, cos alpha = 1, G = 1), cos beta = cos 30:
+    //   rs = 8.19844 / 9.48016 = 0.864800, rp = 6.42612 / 7.70783 = 0.833712, F = 0.849256;
+    // - wi at 80 and wo at 40 degrees on one side (h at 60 degrees, beta = 20 degrees, G as in
+    //   the test above): rs = 0.856145, rp = 0.842647, F = 0.849396.
+    // Schlick's R0 from eta alone, ((0.37 - 1) / (0.37 + 1))^2 = 0.2115, is what prism used
+    // before: a quarter of it.
+    const double p = 50, deg = pi / 180;
+    struct Case {
+        double theta_i, theta_o, cos_alpha, cos_beta, geometry, fresnel;
+    };
+    const Case cases[] = {{-30, 30, 1, std::cos(30 * deg), 1, 0.849256166393},
+                          {80, 40, std::cos(60 * deg), std::cos(20 * deg),
+                           2 * std::cos(60 * deg) * std::cos(80 * deg) / std::cos(20 * deg), 0.849396304866}};
+    scene::Material description = course_material(brdf_of(scene::BrdfModel::torrance_sparrow, p), 0.370);
+    description.absorption_index = 2.820;
+    const prism::Material<Real> material(description);
+    const auto& model = std::get<prism::TorranceSparrow<Real>>(material.brdf);
+    // At normal incidence the conductor's F is ((n - 1)^2 + k^2) / ((n + 1)^2 + k^2)
+    // = 8.3493 / 9.8293 = 0.849430.
+    CHECK(double(model.fresnel_at(Real(1))) == doctest::Approx(0.849429766107).epsilon(1e-6));
+    const double epsilon = std::is_same_v<Real, float> ? 1e-5 : 1e-10;
+    for (const Case& c : cases) {
+        CAPTURE(c.theta_i);
+        const Vec3<Real> n(0, 0, 1);
+        const Vec3<Real> wi(Real(std::sin(c.theta_i * deg)), 0, Real(std::cos(c.theta_i * deg)));
+        const Vec3<Real> wo(Real(std::sin(c.theta_o * deg)), 0, Real(std::cos(c.theta_o * deg)));
+        CHECK(double(model.fresnel_at(Real(c.cos_beta))) == doctest::Approx(c.fresnel).epsilon(epsilon));
+        const double distribution = (p + 2) / (2 * pi) * std::pow(c.cos_alpha, p);
+        const double specular = distribution * c.fresnel * c.geometry /
+                                (4 * std::cos(c.theta_i * deg) * std::cos(c.theta_o * deg));
+        const Vec3<Real> f = prism::evaluate_brdf(material, n, wi, wo);
+        // kdfresnel="false": the diffuse term is kd / pi, whatever F.
+        for (int channel = 0; channel < 3; ++channel)
+            CHECK(double(f[channel]) == doctest::Approx(description.diffuse[channel] / pi +
+                                                        description.specular[channel] * specular)
+                                            .epsilon(epsilon));
+    }
+}
+
 TEST_CASE_TEMPLATE("BRDFs: the normalised models reflect at most what arrives", Real, float, double) {
     using M = scene::BrdfModel;
     const int cells = 600;

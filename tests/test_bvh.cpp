@@ -988,14 +988,14 @@ TEST_CASE_TEMPLATE("SceneGeometry: back-face culling skips surfaces facing away,
     // The course's rule skips the flat triangle but keeps the plane.
     ray = from_behind;
     ray.t_min = Real(6);
-    CHECK_FALSE(geometry.template intersect<BackfaceCulling::flat_triangles>(ray, hit));
+    CHECK_FALSE(geometry.template intersect<BackfaceCulling::triangles>(ray, hit));
     ray = from_behind;
-    REQUIRE(geometry.template intersect<BackfaceCulling::flat_triangles>(ray, hit));
+    REQUIRE(geometry.template intersect<BackfaceCulling::triangles>(ray, hit));
     CHECK(hit.object == 1);
     });
 }
 
-TEST_CASE_TEMPLATE("SceneGeometry: the course's culling keeps smooth meshes and follows instances' transformations",
+TEST_CASE_TEMPLATE("SceneGeometry: the course's culling skips smooth meshes too and follows instances' transformations",
                    Real, float, double) {
     using prism::BackfaceCulling;
     scene::Scene world;
@@ -1013,15 +1013,18 @@ TEST_CASE_TEMPLATE("SceneGeometry: the course's culling keeps smooth meshes and 
     {
         const BvhGeometry<Real> geometry(world);
         prism::Ray<Real> ray = from_behind;
-        // From behind the smooth triangle (t = 9) is met first and kept; flat and all differ.
-        REQUIRE(geometry.template intersect<BackfaceCulling::flat_triangles>(ray, hit));
-        CHECK(hit.t == Real(9));
-        CHECK(hit.object == 1);
+        // From behind both triangles face away: the smooth one (t = 9) is skipped as the flat
+        // one is; without culling it is met first.
+        CHECK_FALSE(geometry.template intersect<BackfaceCulling::triangles>(ray, hit));
         ray = from_behind;
         CHECK_FALSE(geometry.template intersect<BackfaceCulling::all>(ray, hit));
+        ray = from_behind;
+        REQUIRE(geometry.template intersect<BackfaceCulling::none>(ray, hit));
+        CHECK(hit.t == Real(9));
+        CHECK(hit.object == 1);
         // From the front, nothing is culled: the flat triangle at t = 10 is nearer.
         ray = from_front;
-        REQUIRE(geometry.template intersect<BackfaceCulling::flat_triangles>(ray, hit));
+        REQUIRE(geometry.template intersect<BackfaceCulling::triangles>(ray, hit));
         CHECK(hit.t == Real(10));
         CHECK(hit.object == 0);
     }
@@ -1033,10 +1036,10 @@ TEST_CASE_TEMPLATE("SceneGeometry: the course's culling keeps smooth meshes and 
     world.mesh_instances.push_back({"turned", 0, 0, turned, {}, {}});
     const BvhGeometry<Real> geometry(world);
     prism::Ray<Real> ray = from_behind;
-    REQUIRE(geometry.template intersect<BackfaceCulling::flat_triangles>(ray, hit));
+    REQUIRE(geometry.template intersect<BackfaceCulling::triangles>(ray, hit));
     CHECK(hit.t == doctest::Approx(11).epsilon(1e-6));
     ray = from_front;
-    REQUIRE(geometry.template intersect<BackfaceCulling::flat_triangles>(ray, hit));
+    REQUIRE(geometry.template intersect<BackfaceCulling::triangles>(ray, hit));
     CHECK(hit.t == doctest::Approx(10).epsilon(1e-6));
     ray = from_front;
     REQUIRE(geometry.template intersect<BackfaceCulling::none>(ray, hit));

@@ -152,7 +152,7 @@ TEST_CASE_TEMPLATE("Merged world-space meshes: each hit names its own mesh and t
     compare_with_brute_force<Real, prism::DoubleRefine, prism::WideBvh<prism::DoubleRefine, 8>>(world);
 }
 
-TEST_CASE_TEMPLATE("Merged world-space meshes: back-face culling follows each mesh's shading", Real, float, double) {
+TEST_CASE_TEMPLATE("Merged world-space meshes: back-face culling skips flat and smooth meshes alike", Real, float, double) {
     using prism::BackfaceCulling;
     scene::Scene world;
     world.materials.push_back({});
@@ -178,8 +178,8 @@ TEST_CASE_TEMPLATE("Merged world-space meshes: back-face culling follows each me
         bool found = false;
         switch (culling) {
             case BackfaceCulling::none: found = geometry.template intersect<BackfaceCulling::none>(ray, hit); break;
-            case BackfaceCulling::flat_triangles:
-                found = geometry.template intersect<BackfaceCulling::flat_triangles>(ray, hit);
+            case BackfaceCulling::triangles:
+                found = geometry.template intersect<BackfaceCulling::triangles>(ray, hit);
                 break;
             case BackfaceCulling::all: found = geometry.template intersect<BackfaceCulling::all>(ray, hit); break;
         }
@@ -193,15 +193,15 @@ TEST_CASE_TEMPLATE("Merged world-space meshes: back-face culling follows each me
         // front (10) face away.
         CHECK(first_hit(geometry, from_below, 0, BackfaceCulling::all) == P(3, 7));
         CHECK(first_hit(geometry, from_below, Real(8.5), BackfaceCulling::none) == P(1, 9));
-        CHECK(first_hit(geometry, from_below, Real(8.5), BackfaceCulling::flat_triangles) == P(1, 9));
+        CHECK(first_hit(geometry, from_below, Real(8.5), BackfaceCulling::triangles) == P(-1, 0));
         CHECK(first_hit(geometry, from_below, Real(8.5), BackfaceCulling::all) == P(-1, 0));
-        CHECK(first_hit(geometry, from_below, Real(9.5), BackfaceCulling::flat_triangles) == P(-1, 0));
+        CHECK(first_hit(geometry, from_below, Real(9.5), BackfaceCulling::triangles) == P(-1, 0));
         CHECK(first_hit(geometry, from_below, Real(9.5), BackfaceCulling::none) == P(0, 10));
         // From above: front (10) and smooth (11) face the ray; back (12) and smooth_back (13)
-        // face away: the course's rule skips only the flat one.
+        // face away: the course's rule skips both.
         CHECK(first_hit(geometry, from_above, 0, BackfaceCulling::all) == P(0, 10));
         CHECK(first_hit(geometry, from_above, Real(11.5), BackfaceCulling::none) == P(2, 12));
-        CHECK(first_hit(geometry, from_above, Real(11.5), BackfaceCulling::flat_triangles) == P(3, 13));
+        CHECK(first_hit(geometry, from_above, Real(11.5), BackfaceCulling::triangles) == P(-1, 0));
         CHECK(first_hit(geometry, from_above, Real(11.5), BackfaceCulling::all) == P(-1, 0));
         // Shadow rays cull nothing.
         prism::Ray<Real> shadow = from_above;

@@ -223,7 +223,7 @@ TEST_CASE_TEMPLATE("PathTracer: camera rays through the batch entries give each 
     using Batched = prism::Config<Real, prism::WideBvh<prism::Watertight, 8>, prism::AllLightSet, prism::all_features,
                                   prism::PathTracer>;
     using Whole = prism::Renderer<Batched>;
-    const prism::RendererSettings settings{prism::BackfaceCulling::flat_triangles, prism::RayOffset::scene_epsilon, 3};
+    const prism::RendererSettings settings{prism::BackfaceCulling::triangles, prism::RayOffset::scene_epsilon, 3};
     const Whole renderer(world, settings);
     const typename Whole::Geometry geometry(world);
     const typename Whole::LightSetT lights(world);

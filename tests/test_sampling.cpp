@@ -268,7 +268,7 @@ TEST_CASE_TEMPLATE("Renderer: multisampled, lens, area-lit, glossy and moving im
     for (const auto& pixel : one.pixels) brightest = std::max(brightest, pixel.r);
     CHECK(brightest > 0.1f);
     // Another seed gives another image (the streams are really used).
-    const prism::Renderer<Complete> reseeded(world, prism::RendererSettings{prism::BackfaceCulling::flat_triangles, prism::RayOffset::scene_epsilon, 99});
+    const prism::Renderer<Complete> reseeded(world, prism::RendererSettings{prism::BackfaceCulling::triangles, prism::RayOffset::scene_epsilon, 99});
     CHECK(reseeded.render(world.cameras[0]).pixels != one.pixels);
 }
 
@@ -480,7 +480,7 @@ TEST_CASE_TEMPLATE("Renderer: a pixel's samples lit side by side (radiances_at) 
             for (const int count : {5, 16, 40}) {
                 CAPTURE(count);
                 world.cameras[0].num_samples = count;
-                const prism::RendererSettings settings{prism::BackfaceCulling::flat_triangles, offset, 7};
+                const prism::RendererSettings settings{prism::BackfaceCulling::triangles, offset, 7};
                 const Whole renderer(world, settings);
                 const prism::Image image = renderer.render(world.cameras[0]);
                 // The renderer's parts, made as Renderer's constructor makes them.

@@ -344,8 +344,7 @@ TEST_CASE_TEMPLATE("Renderer: a mirror adds km times the radiance of the reflect
     }
 }
 
-TEST_CASE_TEMPLATE("Renderer: camera rays skip a flat back face, as the course does, and see a smooth one",
-                   Real, float, double) {
+TEST_CASE_TEMPLATE("Renderer: camera rays skip a back face, flat or smooth, as the course does", Real, float, double) {
     // A small triangle at z = -1 wound to face away from the camera, between the camera and the
     // lit triangle at z = -2, and clear of the lit point's shadow ray towards (1, 2, 0).
     scene::Scene world = lit_scene();
@@ -370,20 +369,19 @@ TEST_CASE_TEMPLATE("Renderer: camera rays skip a flat back face, as the course d
         const prism::Renderer<prism::Config<Real>> renderer(world, {culling});
         return glm::dvec3(renderer.render(world.cameras[0])(1, 1));
     };
-    SUBCASE("flat: the default skips it, --cull-backfaces too, --no-cull-backfaces shows it") {
+    // The default, --cull-backfaces too, skip it whatever its shading (issue 30: the held-out
+    // smooth windmill); --no-cull-backfaces shows it.
+    for (const auto shading : {scene::ShadingMode::flat, scene::ShadingMode::smooth}) {
+        world.meshes.back().shading = shading;
+        CAPTURE(int(shading));
         check_relative(centre_pixel<Real>(world), lit, 1e-4);
-        check_relative(centre(prism::BackfaceCulling::flat_triangles), lit, 1e-4);
+        check_relative(centre(prism::BackfaceCulling::triangles), lit, 1e-4);
         check_relative(centre(prism::BackfaceCulling::all), lit, 1e-4);
         check_relative(centre(prism::BackfaceCulling::none), back_face, 1e-4);
     }
-    SUBCASE("smooth: the default shows it, only --cull-backfaces skips it") {
-        world.meshes.back().shading = scene::ShadingMode::smooth;
-        check_relative(centre_pixel<Real>(world), back_face, 1e-4);
-        check_relative(centre(prism::BackfaceCulling::all), lit, 1e-4);
-    }
     SUBCASE("turned to face the camera, it hides the lit triangle whatever the rule") {
         std::swap(world.meshes.back().triangles[0][1], world.meshes.back().triangles[0][2]);
-        for (const auto culling : {prism::BackfaceCulling::none, prism::BackfaceCulling::flat_triangles,
+        for (const auto culling : {prism::BackfaceCulling::none, prism::BackfaceCulling::triangles,
                                    prism::BackfaceCulling::all})
             check_relative(centre(culling), back_face, 1e-4);
     }

@@ -390,7 +390,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: camera rays side by side through the index ge
                     rays += std::size_t(count);
                 };
                 compare.template operator()<BackfaceCulling::none>();
-                compare.template operator()<BackfaceCulling::flat_triangles>();
+                compare.template operator()<BackfaceCulling::triangles>();
                 compare.template operator()<BackfaceCulling::all>();
             }
             CHECK(differ == 0);

@@ -88,7 +88,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: a top level of a few spheres tested directly 
     using Geometry = prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>;
     for (const bool more : {false, true})
     for (const bool with_mesh : {false, true}) {
-        for (const prism::BackfaceCulling culling : {prism::BackfaceCulling::none, prism::BackfaceCulling::flat_triangles}) {
+        for (const prism::BackfaceCulling culling : {prism::BackfaceCulling::none, prism::BackfaceCulling::triangles}) {
         CAPTURE(int(culling));
         CAPTURE(with_mesh);
         CAPTURE(more);
@@ -123,10 +123,10 @@ TEST_CASE_TEMPLATE("SceneGeometry: a top level of a few spheres tested directly 
             prism::Hit<Real> hit_a, hit_b;
             const bool found_a = culling == prism::BackfaceCulling::none
                                      ? direct.intersect(a, hit_a)
-                                     : direct.template intersect<prism::BackfaceCulling::flat_triangles>(a, hit_a);
+                                     : direct.template intersect<prism::BackfaceCulling::triangles>(a, hit_a);
             const bool found_b = culling == prism::BackfaceCulling::none
                                      ? indexed.intersect(b, hit_b)
-                                     : indexed.template intersect<prism::BackfaceCulling::flat_triangles>(b, hit_b);
+                                     : indexed.template intersect<prism::BackfaceCulling::triangles>(b, hit_b);
             REQUIRE(found_a == found_b);
             CHECK(direct.occluded(ray) == indexed.occluded(ray));
             if (!found_a) continue;
@@ -217,7 +217,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: tiny world-space meshes tested without their 
             default: return p0 + a * (1 - b) * (p1 - p0) + a * b * (p2 - p0);
         }
     };
-    const prism::BackfaceCulling cullings[] = {prism::BackfaceCulling::none, prism::BackfaceCulling::flat_triangles,
+    const prism::BackfaceCulling cullings[] = {prism::BackfaceCulling::none, prism::BackfaceCulling::triangles,
                                                prism::BackfaceCulling::all};
     std::size_t hits = 0, mesh_hits = 0, top_mesh_hits = 0, blocked = 0, rays = 0;
     for (int i = 0; i < 120000; ++i) {
@@ -271,8 +271,8 @@ TEST_CASE_TEMPLATE("SceneGeometry: tiny world-space meshes tested without their 
             const auto closest = [&](const Geometry& geometry, prism::Ray<Real>& r, prism::Hit<Real>& hit) {
                 switch (culling) {
                     case prism::BackfaceCulling::none: return geometry.intersect(r, hit);
-                    case prism::BackfaceCulling::flat_triangles:
-                        return geometry.template intersect<prism::BackfaceCulling::flat_triangles>(r, hit);
+                    case prism::BackfaceCulling::triangles:
+                        return geometry.template intersect<prism::BackfaceCulling::triangles>(r, hit);
                     default: return geometry.template intersect<prism::BackfaceCulling::all>(r, hit);
                 }
             };
@@ -485,7 +485,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: a world-space index whose root has two leaves
         }
         return p;
     };
-    const prism::BackfaceCulling cullings[] = {prism::BackfaceCulling::none, prism::BackfaceCulling::flat_triangles};
+    const prism::BackfaceCulling cullings[] = {prism::BackfaceCulling::none, prism::BackfaceCulling::triangles};
     std::size_t rays = 0, hits = 0, wall_hits = 0, blocked = 0, edge_rays = 0;
     for (int i = 0; i < 100000; ++i) {
         glm::dvec3 origin, direction;
@@ -643,7 +643,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: camera rays tested several at a time get what
         const auto intersect = [&](BackfaceCulling culling, prism::Ray<Real>& ray, prism::Hit<Real>& hit) {
             switch (culling) {
                 case BackfaceCulling::none: return geometry.template intersect<BackfaceCulling::none>(ray, hit);
-                case BackfaceCulling::flat_triangles: return geometry.template intersect<BackfaceCulling::flat_triangles>(ray, hit);
+                case BackfaceCulling::triangles: return geometry.template intersect<BackfaceCulling::triangles>(ray, hit);
                 case BackfaceCulling::all: break;
             }
             return geometry.template intersect<BackfaceCulling::all>(ray, hit);
@@ -651,8 +651,8 @@ TEST_CASE_TEMPLATE("SceneGeometry: camera rays tested several at a time get what
         const auto intersect_each = [&](BackfaceCulling culling, prism::Ray<Real>* rays, prism::Hit<Real>* hits, int count) {
             switch (culling) {
                 case BackfaceCulling::none: return geometry.template intersect_each<BackfaceCulling::none>(rays, hits, count);
-                case BackfaceCulling::flat_triangles:
-                    return geometry.template intersect_each<BackfaceCulling::flat_triangles>(rays, hits, count);
+                case BackfaceCulling::triangles:
+                    return geometry.template intersect_each<BackfaceCulling::triangles>(rays, hits, count);
                 case BackfaceCulling::all: break;
             }
             return geometry.template intersect_each<BackfaceCulling::all>(rays, hits, count);

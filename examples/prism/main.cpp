@@ -63,8 +63,8 @@ options:
                        types existed, mean it)
   --cull-backfaces     camera rays ignore every triangle and plane facing away from them
   --no-cull-backfaces  camera rays see every surface from both sides. Default (neither): the
-                       course's rule, camera rays ignore back-facing triangles of flat-shaded
-                       meshes and see smooth-shaded meshes, spheres and planes from both sides
+                       course's rule, camera rays ignore back-facing triangles of every mesh
+                       and see spheres and planes from both sides
   --max-recursion-depth N
                        the largest MaxRecursionDepth a scene may ask for (default 64; at most
                        512, the depth the renderer's stack is known to hold)

@@ -75,7 +75,8 @@ options:
   --seed N             selects the pixels' random streams (default 0)
   --cull-backfaces     camera rays ignore every triangle and plane facing away from them
   --no-cull-backfaces  camera rays see every surface from both sides (default: the course's
-                       rule, back-facing triangles of flat-shaded meshes only)
+                       rule, back-facing triangles of every mesh; spheres and planes are
+                       seen from both sides)
   --accelerator A      prism (the default) or embree (Embree 3 finds the hits; only when built
                        with libembree-dev)
   --hdr                compare radiance, and only images whose reference is HDR (.exr, .hdr):

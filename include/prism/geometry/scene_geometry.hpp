@@ -77,17 +77,14 @@ public:
 
     explicit SceneGeometry(const scene::Scene& scene) {
         const std::vector<bool> merged = merged_meshes(scene);
-        // A culling class of one mesh needs no merged index: that mesh keeps its own, read
-        // without the translation a merged index's hits need (a cache miss per hit ray on the
-        // 766k-triangle dragon: 5-9% of its camera rays' time).
-        std::size_t class_size[2] = {0, 0};
-        for (std::size_t m = 0; m < scene.meshes.size(); ++m)
-            if (merged[m]) ++class_size[scene.meshes[m].shading == scene::ShadingMode::smooth];
-        auto alone = [&](std::size_t m) { return class_size[scene.meshes[m].shading == scene::ShadingMode::smooth] == 1; };
+        // A single merged mesh needs no merged index: it keeps its own, read without the
+        // translation a merged index's hits need (a cache miss per hit ray on the 766k-triangle
+        // dragon: 5-9% of its camera rays' time).
+        const bool alone = std::count(merged.begin(), merged.end(), true) == 1;
         meshes_.reserve(scene.meshes.size());
         for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
             const scene::Mesh& mesh = scene.meshes[m];
-            if (merged[m] && !alone(m)) meshes_.emplace_back(mesh, typename Mesh::ShadingOnly{});
+            if (merged[m] && !alone) meshes_.emplace_back(mesh, typename Mesh::ShadingOnly{});
             else meshes_.emplace_back(mesh);
             add_instance(Kind::mesh, std::uint32_t(meshes_.size() - 1), mesh.material, mesh.transform,
                          meshes_.back().bounds(), mesh.textures, mesh.motion);
@@ -120,23 +117,21 @@ public:
             plane_materials_.push_back(std::uint32_t(plane.material));
             plane_textures_.push_back(add_texture_list(plane.textures));
         }
-        // One index per culling class over the merged meshes (flat ones are culled under
-        // flat_triangles, smooth ones never), the instance of mesh m being object m.
-        for (const bool smooth : {false, true}) {
+        // One index over the merged meshes, flat and smooth alike (they are culled alike), the
+        // instance of mesh m being object m.
+        {
             WorldMeshes group;
-            group.smooth = smooth;
             std::vector<const scene::Mesh*> parts;
             std::uint32_t triangles = 0;
             for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
-                if (!merged[m] || meshes_[m].smooth() != smooth) continue;
+                if (!merged[m]) continue;
                 parts.push_back(&scene.meshes[m]);
                 group.objects.push_back(std::uint32_t(m));
                 group.first_triangle.push_back(triangles);
                 triangles += std::uint32_t(scene.meshes[m].triangles.size());
             }
-            if (parts.empty()) continue;
             if (parts.size() > 1) group.index.emplace(std::span<const scene::Mesh* const>(parts));
-            world_meshes_.push_back(std::move(group));
+            if (!parts.empty()) world_meshes_.push_back(std::move(group));
         }
         std::vector<Aabb<Real>> boxes;
         for (std::uint32_t object = 0; object < instances_.size(); ++object) {
@@ -216,7 +211,7 @@ private:
         std::optional<RayBoxPrecomputed<Real>> box_ray;  // made once, for the first group's box
         for (const WorldMeshes& group : world_meshes_) {
             const Mesh& index = index_of(group);
-            const bool cull = culls_back_faces(Culling, group.smooth);
+            const bool cull = culls_back_faces(Culling);
             bool group_hit = false;
             if (group.leaves) {
                 if constexpr (Mesh::packed) {
@@ -363,7 +358,7 @@ public:
                         typename Packets::LaneHits lane_hits;
                         lane_hits.t_max = lanes_t_max<Packets>(group, n);
                         const Mesh& index = index_of(mesh_group);
-                        if (culls_back_faces(Culling, mesh_group.smooth))
+                        if (culls_back_faces(Culling))
                             index.template intersect_leaf_lanes<true>(*lanes_ray, leaf, lanes, lane_hits);
                         else
                             index.template intersect_leaf_lanes<false>(*lanes_ray, leaf, lanes, lane_hits);
@@ -502,12 +497,10 @@ public:
     // Whether camera rays skip object's back-facing triangles under `culling`, as intersect does.
     bool culls(std::uint32_t object, BackfaceCulling culling) const {
         const Instance& instance = instances_[object];
-        return instance.kind == Kind::mesh && culls_back_faces(culling, meshes_[instance.shape].smooth());
+        return instance.kind == Kind::mesh && culls_back_faces(culling);
     }
-    // The rule itself, for a mesh of smooth (vertex-normal) or flat shading.
-    static constexpr bool culls_back_faces(BackfaceCulling culling, bool smooth) {
-        return culling == BackfaceCulling::all || (culling == BackfaceCulling::flat_triangles && !smooth);
-    }
+    // The rule itself for a mesh's triangles, whatever their shading (geometry/backface_culling.hpp).
+    static constexpr bool culls_back_faces(BackfaceCulling culling) { return culling != BackfaceCulling::none; }
     Aabb<Real> world_bounds(std::uint32_t object) const { return instances_[object].world_bounds; }
 
     // Two parts are left out for callers that never read them. `Parametrised` false leaves a
@@ -819,7 +812,7 @@ private:
         std::uint32_t found = 0;
         for (const WorldMeshes& group : world_meshes_) {
             const Mesh& index = index_of(group);
-            const bool cull = culls_back_faces(Culling, group.smooth);
+            const bool cull = culls_back_faces(Culling);
             std::uint32_t lanes = 0;
             for (std::uint32_t rest = present; rest != 0; rest &= rest - 1) {
                 const int i = std::countr_zero(rest);
@@ -893,7 +886,7 @@ private:
                     if (instance.kind == Kind::mesh && in_world_space(instance)) {
                         const TriangleRay* const world_triangle = world.triangles(testing);
                         const Mesh& mesh = meshes_[instance.shape];
-                        instance_hits = culls_back_faces(Culling, mesh.smooth())
+                        instance_hits = culls_back_faces(Culling)
                                             ? mesh.template intersect_lanes<true>(rays, traversal.data(), world_triangle, t_min,
                                                                                   t_max, testing, hits, tied)
                                             : mesh.template intersect_lanes<false>(rays, traversal.data(), world_triangle, t_min,
@@ -953,7 +946,7 @@ private:
         ObjectSpaceRays local;
         local.make(*this, instance, rays, lanes);
         const Mesh& mesh = meshes_[instance.shape];
-        return culls_back_faces(Culling, mesh.smooth())
+        return culls_back_faces(Culling)
                    ? mesh.template intersect_lanes<true>(local.ray.data(), local.traversal.data(), local.triangle.data(),
                                                          t_min, t_max, lanes, hits, tied)
                    : mesh.template intersect_lanes<false>(local.ray.data(), local.traversal.data(), local.triangle.data(),
@@ -1122,7 +1115,7 @@ private:
                                                    Hit<Real>& hit) const {
         if (instance.kind == Kind::mesh) {
             const auto& mesh = meshes_[instance.shape];
-            const bool cull = culls_back_faces(Culling, mesh.smooth());
+            const bool cull = culls_back_faces(Culling);
             if (in_world_space(instance)) {
                 if (!world_triangle_ray) world_triangle_ray.emplace(ray);
                 return cull ? mesh.template intersect<true>(ray, traversal_ray, *world_triangle_ray, t_max, hit)
@@ -1511,7 +1504,7 @@ private:
                 if (!local) continue;
                 const Mesh& mesh = meshes_[instances_[direct.object].shape];
                 const TriangleRay triangle_ray(*local);
-                const bool cull = culls_back_faces(Culling, mesh.smooth());
+                const bool cull = culls_back_faces(Culling);
                 if (cull ? mesh.template intersect_leaf<true>(*local, triangle_ray, direct.leaf, ray.t_max, hit)
                          : mesh.template intersect_leaf<false>(*local, triangle_ray, direct.leaf, ray.t_max, hit)) {
                     hit.object = direct.object;
@@ -1593,7 +1586,7 @@ private:
             bool found = false;
             for (const WorldMeshes& group : world_meshes_) {
                 const Mesh& index = index_of(group);
-                const bool cull = culls_back_faces(Culling, group.smooth);
+                const bool cull = culls_back_faces(Culling);
                 const bool group_hit = cull ? intersect_root_leaves<true, TwoLeaves>(index, *group.leaves, ray, triangle_ray, hit)
                                             : intersect_root_leaves<false, TwoLeaves>(index, *group.leaves, ray, triangle_ray, hit);
                 if (group_hit) {
@@ -1672,12 +1665,11 @@ private:
         return false;
     }
 
-    // The merged meshes of one culling class and the index over their triangles.
+    // The merged meshes and the index over their triangles.
     struct WorldMeshes {
         // Over the parts' triangles, numbered part after part; none for a single part, which
         // is traversed through its own mesh's index (and keeps its index order).
         std::optional<Mesh> index;
-        bool smooth = false;        // its parts' culling class
         std::vector<std::uint32_t> objects;         // per part, its object (Hit::object)
         std::vector<std::uint32_t> first_triangle;  // per part, the number of its first triangle
         std::optional<typename Mesh::RootLeaves> leaves;  // the index's leaves, when its root has only one or two (direct_)

@@ -44,7 +44,8 @@ Brdf<Real> make_brdf(const scene::Material& material) {
         case scene::BrdfModel::original_blinn_phong: return OriginalBlinnPhong<Real>{exponent};
         case scene::BrdfModel::modified_blinn_phong: return ModifiedBlinnPhong<Real>{exponent, b.normalized};
         case scene::BrdfModel::torrance_sparrow:
-            return TorranceSparrow<Real>{exponent, b.kdfresnel, Real(material.refraction_index)};
+            return TorranceSparrow<Real>{exponent, b.kdfresnel, Real(material.refraction_index),
+                                         Real(material.absorption_index)};
     }
     return OriginalBlinnPhong<Real>{Real(material.phong_exponent)};
 }

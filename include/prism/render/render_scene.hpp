@@ -69,7 +69,7 @@ struct RenderOptions {
     // > 0 replaces every camera's NumSamples (before the cap): a reduced image compared with a
     // box-filtered noisy reference needs more samples per pixel to match its noise per area
     int samples = 0;
-    BackfaceCulling backface_culling = BackfaceCulling::flat_triangles;  // what camera rays skip from behind
+    BackfaceCulling backface_culling = BackfaceCulling::triangles;  // what camera rays skip from behind
     std::optional<RayOffset> ray_offset;  // empty: chosen from the scene (choose_ray_offset)
     std::uint64_t seed = 0;               // the pixels' random streams (multisampling, lights)
     AcceleratorChoice accelerator = AcceleratorChoice::prism;

@@ -30,7 +30,7 @@
 namespace prism {
 
 struct RendererSettings {
-    BackfaceCulling backface_culling = BackfaceCulling::flat_triangles;  // what camera rays skip from behind
+    BackfaceCulling backface_culling = BackfaceCulling::triangles;  // what camera rays skip from behind
     RayOffset ray_offset = RayOffset::scene_epsilon;
     std::uint64_t seed = 0;       // selects the pixels' random streams
 };

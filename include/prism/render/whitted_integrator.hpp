@@ -65,7 +65,7 @@ struct IntegratorSettings {
     double shadow_ray_epsilon = 1e-3;  // RayOffset::scene_epsilon's offset
     RayOffset ray_offset = RayOffset::scene_epsilon;
     // What camera rays skip when they meet it from behind; secondary rays see every back face.
-    BackfaceCulling backface_culling = BackfaceCulling::flat_triangles;
+    BackfaceCulling backface_culling = BackfaceCulling::triangles;
 };
 
 // A surface's textures as the integrator uses them; `NoTextures` is the policy of renderers
@@ -188,8 +188,8 @@ public:
         } else {
             switch (settings_.backface_culling) {
                 case BackfaceCulling::none: break;
-                case BackfaceCulling::flat_triangles:
-                    return geometry_.template intersect_each<BackfaceCulling::flat_triangles>(rays, hits, count);
+                case BackfaceCulling::triangles:
+                    return geometry_.template intersect_each<BackfaceCulling::triangles>(rays, hits, count);
                 case BackfaceCulling::all: return geometry_.template intersect_each<BackfaceCulling::all>(rays, hits, count);
             }
             return geometry_.template intersect_each<BackfaceCulling::none>(rays, hits, count);
