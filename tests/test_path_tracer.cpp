@@ -1,6 +1,7 @@
 // The path tracer: a furnace with an analytic answer under every RendererParams combination,
 // every combination converging to the same image within its noise, images identical at any
 // thread count, and dispatch: the path tracer only for scenes with a path-traced camera.
+#include "one_by_one_pixel.hpp"
 #include "temporary_folder.hpp"
 
 #include <prism/io/load.hpp>
@@ -225,18 +226,8 @@ TEST_CASE_TEMPLATE("PathTracer: camera rays through the batch entries give each 
     using Whole = prism::Renderer<Batched>;
     const prism::RendererSettings settings{prism::BackfaceCulling::triangles, prism::RayOffset::scene_epsilon, 3};
     const Whole renderer(world, settings);
-    const typename Whole::Geometry geometry(world);
-    const typename Whole::LightSetT lights(world);
-    std::vector<prism::Material<Real>> materials;
-    for (const scene::Material& material : world.materials) materials.emplace_back(material);
-    const typename Whole::TexturesT textures(world);
-    const typename Whole::EnvironmentT environment(*lights.template of_type<prism::EnvironmentLight>());
-    const typename Whole::Integrator integrator(geometry, lights, materials, textures, environment,
-                                                prism::Vec3<Real>(world.ambient_light),
-                                                prism::Vec3<Real>(world.background_color),
-                                                prism::IntegratorSettings{world.max_recursion_depth,
-                                                                          world.shadow_ray_epsilon, settings.ray_offset,
-                                                                          settings.backface_culling});
+    const prism_test::RendererParts<Whole> parts(world, settings);
+    const auto& integrator = parts.integrator;
     REQUIRE(integrator.batches_camera_rays());
     std::vector<scene::RendererParams> cameras = {{true, true, true, true, true}, {true, false, false, false, false},
                                                   {true, true, false, true, false}, {}};
@@ -252,29 +243,14 @@ TEST_CASE_TEMPLATE("PathTracer: camera rays through the batch entries give each 
             camera.num_samples = count;
             const prism::Image image = renderer.render(camera);
             const prism::ThinLensCamera<Real> lens(camera, camera.width, camera.height);
-            std::vector<prism::CameraSample<Real>> samples;
-            std::vector<prism::Vec2<Real>> strata;
             int mismatches = 0;
             for (int y = 0; y < camera.height; ++y)
                 for (int x = 0; x < camera.width; ++x) {
-                    prism::Random random = prism::Random::for_pixel(x, y, settings.seed);
-                    typename Whole::Integrator::CameraPath path{
-                        random,
-                        prism::Vec2<Real>((Real(x) + Real(0.5)) / Real(camera.width),
-                                          (Real(y) + Real(0.5)) / Real(camera.height)),
-                        lens.pixel_spread(), params};
-                    if (count == 1) samples = {prism::centre_sample<Real>(random)};
-                    else prism::camera_samples(count, random, samples, strata);
-                    prism::Vec3<Real> sum(0);
-                    Real weights = 0;
-                    for (const prism::CameraSample<Real>& sample : samples) {
-                        const prism::Ray<Real> ray =
-                            lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time);
-                        const Real weight = count == 1 ? Real(1) : prism::filter_weight(camera.filter, sample.pixel);
-                        sum += weight * integrator.radiance(ray, path);
-                        weights += weight;
-                    }
-                    const glm::vec3 expected(sum / weights);
+                    const glm::vec3 expected = prism_test::one_by_one_pixel(
+                        integrator, lens, camera, count, x, y, settings.seed,
+                        [&](prism::Random& random, const prism::Vec2<Real>& pixel_uv, Real spread) {
+                            return typename Whole::Integrator::CameraPath{random, pixel_uv, spread, params};
+                        });
                     mismatches += std::memcmp(&expected, &image(x, y), sizeof expected) != 0;
                     total += expected.r + expected.g + expected.b;
                 }

@@ -1,6 +1,8 @@
 // The course's distribution ray tracing, for float and double: the per-pixel random streams,
 // stratified camera samples, the reconstruction filter, the thin lens, area lights, motion blur
 // (moving boxes and rays at an instant), roughness, and images bit-identical at 1 and 2 threads.
+#include "one_by_one_pixel.hpp"
+
 #include <prism/camera/pixel_sampler.hpp>
 #include <prism/camera/thin_lens_camera.hpp>
 #include <prism/light/area_light.hpp>
@@ -483,43 +485,19 @@ TEST_CASE_TEMPLATE("Renderer: a pixel's samples lit side by side (radiances_at) 
                 const prism::RendererSettings settings{prism::BackfaceCulling::triangles, offset, 7};
                 const Whole renderer(world, settings);
                 const prism::Image image = renderer.render(world.cameras[0]);
-                // The renderer's parts, made as Renderer's constructor makes them.
-                const typename Whole::Geometry geometry(world);
-                const typename Whole::LightSetT lights(world);
-                std::vector<prism::Material<Real>> materials;
-                for (const scene::Material& material : world.materials) materials.emplace_back(material);
-                const typename Whole::TexturesT textures(world);
-                const typename Whole::EnvironmentT environment(*lights.template of_type<prism::EnvironmentLight>());
-                const typename Whole::Integrator integrator(
-                    geometry, lights, materials, textures, environment, prism::Vec3<Real>(world.ambient_light),
-                    prism::Vec3<Real>(world.background_color),
-                    prism::IntegratorSettings{world.max_recursion_depth, world.shadow_ray_epsilon, offset,
-                                              settings.backface_culling});
+                const prism_test::RendererParts<Whole> parts(world, settings);
+                const auto& integrator = parts.integrator;
                 REQUIRE(integrator.prelights());
                 const prism::ThinLensCamera<Real> lens(world.cameras[0], camera.width, camera.height);
-                std::vector<prism::CameraSample<Real>> samples;
-                std::vector<prism::Vec2<Real>> strata;
                 int mismatches = 0, distinct = 0;
                 std::set<std::array<float, 3>> colours;
                 for (int y = 0; y < camera.height; ++y)
                     for (int x = 0; x < camera.width; ++x) {
-                        prism::Random random = prism::Random::for_pixel(x, y, settings.seed);
-                        typename Whole::Integrator::CameraPath path{
-                            random,
-                            prism::Vec2<Real>((Real(x) + Real(0.5)) / Real(camera.width),
-                                              (Real(y) + Real(0.5)) / Real(camera.height)),
-                            lens.pixel_spread()};
-                        prism::camera_samples(count, random, samples, strata);
-                        prism::Vec3<Real> sum(0);
-                        Real weights = 0;
-                        for (const prism::CameraSample<Real>& sample : samples) {
-                            const prism::Ray<Real> ray = lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y,
-                                                                  sample.lens, sample.time);
-                            const Real weight = prism::filter_weight(camera.filter, sample.pixel);
-                            sum += weight * integrator.radiance(ray, path);
-                            weights += weight;
-                        }
-                        const glm::vec3 expected(sum / weights);
+                        const glm::vec3 expected = prism_test::one_by_one_pixel(
+                            integrator, lens, world.cameras[0], count, x, y, settings.seed,
+                            [](prism::Random& random, const prism::Vec2<Real>& pixel_uv, Real spread) {
+                                return typename Whole::Integrator::CameraPath{random, pixel_uv, spread};
+                            });
                         mismatches += std::memcmp(&expected, &image(x, y), sizeof expected) != 0;
                         colours.insert({expected.r, expected.g, expected.b});
                     }
