@@ -10,6 +10,7 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <sstream>
@@ -203,8 +204,12 @@ TEST_CASE_TEMPLATE("PathTracer: camera rays through the batch entries give each 
     // radiance_at and radiances_at for a pixel's samples). The reference is the integrator's own
     // radiance, ray by ray on each pixel's stream, summed with the filter weights as the
     // Renderer sums them: every pixel's bits must agree, for path-traced cameras under several
-    // RendererParams and for a ray-traced camera in the same renderer. The wide BVH batches the
-    // hits (intersect_each through the index of the box and a 128-triangle ridged floor).
+    // RendererParams and for a ray-traced camera in the same renderer. The Renderer batches the
+    // ray-traced camera's rays only (PathTracerIntegrator::batches_camera_rays), so the batch
+    // entries are also called here as the Renderer calls them, for every camera: a row of
+    // one-sample pixels through radiance_row, a pixel's samples through radiances_at. The wide
+    // BVH batches the hits (intersect_each through the index of the box and a 128-triangle
+    // ridged floor).
     TemporaryFolder folder;
     scene::Scene world = prism::io::load_scene(folder.write("cornell.xml", cornell_xml));
     world.point_lights.push_back({"bulb", {0.2, 0.6, 0.3}, {2, 2, 2}});
@@ -228,7 +233,7 @@ TEST_CASE_TEMPLATE("PathTracer: camera rays through the batch entries give each 
     const Whole renderer(world, settings);
     const prism_test::RendererParts<Whole> parts(world, settings);
     const auto& integrator = parts.integrator;
-    REQUIRE(integrator.batches_camera_rays());
+    using Path = typename Whole::Integrator::CameraPath;
     std::vector<scene::RendererParams> cameras = {{true, true, true, true, true}, {true, false, false, false, false},
                                                   {true, true, false, true, false}, {}};
     for (const scene::RendererParams& params : cameras) {
@@ -243,18 +248,72 @@ TEST_CASE_TEMPLATE("PathTracer: camera rays through the batch entries give each 
             camera.num_samples = count;
             const prism::Image image = renderer.render(camera);
             const prism::ThinLensCamera<Real> lens(camera, camera.width, camera.height);
-            int mismatches = 0;
-            for (int y = 0; y < camera.height; ++y)
+            const auto uv = [&](int x, int y) {
+                return prism::Vec2<Real>((Real(x) + Real(0.5)) / Real(camera.width),
+                                         (Real(y) + Real(0.5)) / Real(camera.height));
+            };
+            // Pixel (x, y) through the batch entries: a row of one-sample pixels (radiance_row),
+            // or the pixel's samples' hits, then radiances_at in chunks of prelit_width.
+            std::vector<prism::CameraSample<Real>> samples;
+            std::vector<prism::Vec2<Real>> strata;
+            std::vector<glm::vec3> row(std::size_t(camera.width));
+            const auto batched_row = [&](int y) {
+                std::vector<prism::Random> streams;
+                std::vector<prism::Ray<Real>> rays;
+                for (int x = 0; x < camera.width; ++x) {
+                    streams.push_back(prism::Random::for_pixel(x, y, settings.seed));
+                    const prism::CameraSample<Real> sample = prism::centre_sample<Real>(streams.back());
+                    rays.push_back(lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time));
+                }
+                std::vector<prism::Hit<Real>> hits(rays.size());
+                const std::uint32_t found = integrator.camera_hits(rays.data(), hits.data(), camera.width);
+                std::vector<prism::Vec3<Real>> radiance(rays.size());
+                integrator.radiance_row(rays.data(), hits.data(), found, camera.width,
+                                        [&](int x) { return Path{streams[std::size_t(x)], uv(x, y), lens.pixel_spread(), params}; },
+                                        radiance.data());
+                for (int x = 0; x < camera.width; ++x) row[std::size_t(x)] = glm::vec3(prism::Vec3<Real>(0) + radiance[std::size_t(x)]);
+            };
+            const auto batched_pixel = [&](int x, int y) {
+                prism::Random random = prism::Random::for_pixel(x, y, settings.seed);
+                Path path{random, uv(x, y), lens.pixel_spread(), params};
+                prism::camera_samples(count, random, samples, strata);
+                std::vector<prism::Ray<Real>> rays;
+                for (const prism::CameraSample<Real>& sample : samples)
+                    rays.push_back(lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time));
+                std::vector<prism::Hit<Real>> hits(rays.size());
+                prism::Vec3<Real> sum(0);
+                Real weights = 0;
+                const int width = Whole::Integrator::prelit_width;
+                for (int part = 0; part < count; part += width) {
+                    const int n = std::min(width, count - part);
+                    const std::uint32_t found = integrator.camera_hits(rays.data() + part, hits.data() + part, n);
+                    std::vector<prism::Vec3<Real>> radiance(static_cast<std::size_t>(n));
+                    integrator.radiances_at(rays.data() + part, hits.data() + part, found, n, path, radiance.data());
+                    for (int i = 0; i < n; ++i) {
+                        const Real weight = prism::filter_weight(camera.filter, samples[std::size_t(part + i)].pixel);
+                        sum += weight * radiance[std::size_t(i)];
+                        weights += weight;
+                    }
+                }
+                return glm::vec3(sum / weights);
+            };
+            int mismatches = 0, batch_mismatches = 0;
+            for (int y = 0; y < camera.height; ++y) {
+                if (count == 1) batched_row(y);
                 for (int x = 0; x < camera.width; ++x) {
                     const glm::vec3 expected = prism_test::one_by_one_pixel(
                         integrator, lens, camera, count, x, y, settings.seed,
                         [&](prism::Random& random, const prism::Vec2<Real>& pixel_uv, Real spread) {
-                            return typename Whole::Integrator::CameraPath{random, pixel_uv, spread, params};
+                            return Path{random, pixel_uv, spread, params};
                         });
                     mismatches += std::memcmp(&expected, &image(x, y), sizeof expected) != 0;
+                    const glm::vec3 batched = count == 1 ? row[std::size_t(x)] : batched_pixel(x, y);
+                    batch_mismatches += std::memcmp(&expected, &batched, sizeof expected) != 0;
                     total += expected.r + expected.g + expected.b;
                 }
+            }
             CHECK(mismatches == 0);
+            CHECK(batch_mismatches == 0);
         }
         CHECK(total > 0);
     }

@@ -9,6 +9,7 @@
 #include <prism/geometry/ray.hpp>
 #include <prism/sampling/random.hpp>
 #include <prism/scene/needs.hpp>
+#include <prism/scene/scene.hpp>
 
 #include <concepts>
 #include <cstdint>
@@ -18,7 +19,7 @@ namespace prism {
 // Everything the Renderer calls (render/renderer.hpp), so that it never asks which of them an
 // integrator has:
 // - radiance: one camera ray's radiance;
-// - camera rays several at a time, where batches_camera_rays(): their closest hits first
+// - camera rays several at a time, where batches_camera_rays(camera): their closest hits first
 //   (camera_hits: bit i of the answer set where rays[i] hits, its t_max lowered to the hit),
 //   then radiance_at from a ray's hit; radiance_row for a row's pixels of one sample each (up
 //   to row_width, `make_path(i)` giving ray i's CameraPath), radiances_at for up to
@@ -29,9 +30,10 @@ template <class I, class Real>
 concept Integrator =
     Scalar<Real> &&
     requires(const I& integrator, const Ray<Real>& ray, Ray<Real>* rays, Hit<Real>* hits, const Hit<Real>& hit,
-             typename I::CameraPath& path, typename I::CameraPath (*make_path)(int), Vec3<Real>* radiance) {
+             typename I::CameraPath& path, typename I::CameraPath (*make_path)(int), Vec3<Real>* radiance,
+             const scene::Camera& camera) {
         { integrator.radiance(ray, path) } -> std::same_as<Vec3<Real>>;
-        { integrator.batches_camera_rays() } -> std::convertible_to<bool>;
+        { integrator.batches_camera_rays(camera) } -> std::convertible_to<bool>;
         { integrator.camera_hits(rays, hits, 1) } -> std::same_as<std::uint32_t>;
         { integrator.radiance_at(ray, hit, true, path) } -> std::same_as<Vec3<Real>>;
         { I::row_width } -> std::convertible_to<int>;

@@ -151,7 +151,7 @@ private:
             }
             // Where the integrator batches camera rays, the row's closest hits first, then its
             // shading (radiance_row: the row's shadow rays side by side where the integrator can).
-            if (integrator_.batches_camera_rays()) {
+            if (integrator_.batches_camera_rays(camera)) {
                 static_assert(Integrator::row_width >= batch);
                 std::array<Hit<Real>, batch> hits;
                 const std::uint32_t found = integrator_.camera_hits(rays.data(), hits.data(), n);
@@ -209,7 +209,7 @@ private:
         // from its hit, in the samples' order: the hits radiance's own intersection finds and
         // the same draws, so the same sum. The traversals then follow one another without a
         // shading in between (hw4 VeachAjar's 16 samples a pixel).
-        if (integrator_.batches_camera_rays()) {
+        if (integrator_.batches_camera_rays(camera)) {
             constexpr std::size_t batch = 32;
             Unconstructed<Hit<Real>, batch> hits;
             for (std::size_t first = 0; first < n; first += batch) {

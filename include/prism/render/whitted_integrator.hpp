@@ -173,7 +173,7 @@ public:
     // by one), then each ray's radiance from its hit (radiance_at), the rest of radiance's
     // work. Index scenes gain from the rows too: their shadow rays go side by side through
     // the index (hw2 horse_instanced: 0.96 of the CPU time with rows, before that).
-    bool batches_camera_rays() const {
+    bool batches_camera_rays(const scene::Camera&) const {
         if constexpr (requires { geometry_.intersection_batches(); }) return true;
         else return false;
     }
