@@ -22,8 +22,10 @@ namespace {
 namespace scene = prism::scene;
 using prism_test::TemporaryFolder;
 
+// The shipped renderers' wide BVH, whose camera rays go side by side through the index: one
+// renderer type per precision for every test here (each more costs minutes of CI's builds).
 template <class Real>
-using PathConfig = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::AllLightSet, prism::all_features,
+using PathConfig = prism::Config<Real, prism::WideBvh<prism::Watertight, 8>, prism::AllLightSet, prism::all_features,
                                  prism::PathTracer>;
 
 // Every combination of the course's three words, and MIS (which implies next-event estimation).
@@ -226,9 +228,7 @@ TEST_CASE_TEMPLATE("PathTracer: camera rays through the batch entries give each 
             ridges.triangles.push_back({b, c, d});
         }
     world.meshes.push_back(ridges);
-    using Batched = prism::Config<Real, prism::WideBvh<prism::Watertight, 8>, prism::AllLightSet, prism::all_features,
-                                  prism::PathTracer>;
-    using Whole = prism::Renderer<Batched>;
+    using Whole = prism::Renderer<PathConfig<Real>>;
     const prism::RendererSettings settings{prism::BackfaceCulling::triangles, prism::RayOffset::scene_epsilon, 3};
     const Whole renderer(world, settings);
     const prism_test::RendererParts<Whole> parts(world, settings);
