@@ -200,7 +200,7 @@ void make_batches(Workload& workload) {
             primary.rays.push_back(ray);
             Ray<double> traced = ray;
             prism::Hit<double> hit;
-            const bool found = reference.intersect(traced, hit);
+            const bool found = prism::closest_hit(reference, traced, hit);
             primary.reference.push_back(found);
             if (!found) continue;
             const prism::SurfacePoint<double> point = reference.surface(traced, hit);
@@ -221,11 +221,11 @@ void make_batches(Workload& workload) {
                                                         std::sqrt(std::max(0.0, 1.0 - u1)) * normal);
             diffuse.rays.push_back(representable_in_float({origin, direction, 0.0, prism::infinity<double>}));
         }
-    for (const Ray<double>& ray : shadow.rays) shadow.reference.push_back(reference.occluded(ray));
+    for (const Ray<double>& ray : shadow.rays) shadow.reference.push_back(prism::blocked(reference, ray));
     for (const Ray<double>& ray : diffuse.rays) {
         Ray<double> traced = ray;
         prism::Hit<double> hit;
-        diffuse.reference.push_back(reference.intersect(traced, hit));
+        diffuse.reference.push_back(prism::closest_hit(reference, traced, hit));
     }
     for (RayBatch& batch : workload.batches)
         for (const Ray<double>& ray : batch.rays) batch.rays_float.push_back(to_float(ray));
@@ -303,12 +303,12 @@ void trace_prism(const Workload& workload, const RayBatch& batch, Answers& answe
     const auto& geometry = geometry_of<Real, Policy>(workload);
     const std::vector<Ray<Real>>& rays = batch.rays_in<Real>();
     if (batch.any_hit) {
-        for (std::size_t i = 0; i < rays.size(); ++i) answers[i] = geometry.occluded(rays[i]);
+        for (std::size_t i = 0; i < rays.size(); ++i) answers[i] = prism::blocked(geometry, rays[i]);
     } else {
         for (std::size_t i = 0; i < rays.size(); ++i) {
             Ray<Real> ray = rays[i];
             prism::Hit<Real> hit;
-            answers[i] = geometry.intersect(ray, hit);
+            answers[i] = prism::closest_hit(geometry, ray, hit);
         }
     }
 }

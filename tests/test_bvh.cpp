@@ -222,7 +222,7 @@ void trace_all(const Geometry& geometry, const std::vector<prism::Ray<Real>>& ra
             Trace<Real>& trace = traces[i];
             prism::Ray<Real> ray = rays[i];
             prism::Hit<Real> hit;
-            trace.hit = geometry.intersect(ray, hit);
+            trace.hit = prism::closest_hit(geometry, ray, hit);
             if (trace.hit) {
                 trace.t = hit.t;
                 trace.t_max_lowered = ray.t_max == hit.t;
@@ -231,7 +231,7 @@ void trace_all(const Geometry& geometry, const std::vector<prism::Ray<Real>>& ra
                 trace.normal = point.geometric_normal;
                 trace.triangle = hit.object == sphere ? -1 : std::lround(double(point.uv.x));
             }
-            if (i % stride == 0) trace.occluded_unbounded = geometry.occluded(rays[i]);
+            if (i % stride == 0) trace.occluded_unbounded = prism::blocked(geometry, rays[i]);
         }
     });
 }
@@ -246,7 +246,7 @@ void occluded_at_half(const Geometry& geometry, const std::vector<prism::Ray<Rea
             if (!reference[i].hit || i % stride != 0) continue;
             prism::Ray<Real> ray = rays[i];
             ray.t_max = reference[i].t / 2;
-            traces[i].occluded_half = geometry.occluded(ray);
+            traces[i].occluded_half = prism::blocked(geometry, ray);
         }
     });
 }
@@ -807,11 +807,11 @@ TEST_CASE_TEMPLATE("BVH on no primitives: an empty tree, an empty mesh, an empty
         for (const prism::Vec3<Real> direction : {prism::Vec3<Real>(0, 0, -1), prism::Vec3<Real>(1, 2, 3)}) {
             prism::Ray<Real> a{prism::Vec3<Real>(0), direction, Real(0), prism::infinity<Real>}, b = a;
             prism::Hit<Real> hit;
-            CHECK_FALSE(bvh.intersect(a, hit));
-            CHECK_FALSE(brute.intersect(b, hit));
+            CHECK_FALSE(prism::closest_hit(bvh, a, hit));
+            CHECK_FALSE(prism::closest_hit(brute, b, hit));
             CHECK(a.t_max == prism::infinity<Real>);
-            CHECK_FALSE(bvh.occluded(a));
-            CHECK_FALSE(brute.occluded(b));
+            CHECK_FALSE(prism::blocked(bvh, a));
+            CHECK_FALSE(prism::blocked(brute, b));
         }
     }
 }
@@ -844,7 +844,7 @@ TEST_CASE_TEMPLATE("BVH on one triangle: never culls a hit at a vertex or an edg
             const bool expected = prism::Watertight::intersect(prepared, p0, p1, p2, ray.t_min, ray.t_max, direct);
             prism::Ray<Real> traced = ray;
             prism::Hit<Real> hit;
-            const bool found = bvh.intersect(traced, hit);
+            const bool found = prism::closest_hit(bvh, traced, hit);
             direct_hits += expected ? 1 : 0;
             if (expected && !found) ++lost;
             if (!expected && found) ++invented;
@@ -901,9 +901,9 @@ TEST_CASE_TEMPLATE("BVH on many copies of one triangle: hits like brute force", 
         const prism::Vec3<Real> origin(Real(uniform(random)), Real(uniform(random)), Real(1));
         prism::Ray<Real> a{origin, glm::normalize(target - origin), Real(0), prism::infinity<Real>}, b = a;
         prism::Hit<Real> hit_a, hit_b;
-        const bool found_a = bvh.intersect(a, hit_a), found_b = brute.intersect(b, hit_b);
+        const bool found_a = prism::closest_hit(bvh, a, hit_a), found_b = prism::closest_hit(brute, b, hit_b);
         hits += found_b ? 1 : 0;
-        if (found_a != found_b || (found_a && hit_a.t != hit_b.t) || bvh.occluded(prism::Ray<Real>{origin, a.direction}) != found_b)
+        if (found_a != found_b || (found_a && hit_a.t != hit_b.t) || prism::blocked(bvh, prism::Ray<Real>{origin, a.direction}) != found_b)
             ++disagreements;
     }
     CHECK(hits > 300);
@@ -936,22 +936,22 @@ TEST_CASE_TEMPLATE("SceneGeometry: the hit interval is the same for triangles, s
         prism::Hit<Real> hit;
         prism::Ray<Real> closed = ray;
         closed.t_max = Real(2);
-        REQUIRE(geometry.intersect(closed, hit));
+        REQUIRE(prism::closest_hit(geometry, closed, hit));
         CHECK(hit.t == Real(2));
         CHECK(closed.t_max == Real(2));
         prism::Ray<Real> short_ray = ray;
         short_ray.t_max = prism::next_down(Real(2));
-        CHECK_FALSE(geometry.intersect(short_ray, hit));
+        CHECK_FALSE(prism::closest_hit(geometry, short_ray, hit));
         prism::Ray<Real> past = ray;
         past.t_min = Real(2);
         past.t_max = Real(2.5);
-        CHECK_FALSE(geometry.intersect(past, hit));
+        CHECK_FALSE(prism::closest_hit(geometry, past, hit));
 
         prism::Ray<Real> shadow = ray;
         shadow.t_max = prism::next_up(Real(2));
-        CHECK(geometry.occluded(shadow));
+        CHECK(prism::blocked(geometry, shadow));
         shadow.t_max = Real(2);
-        CHECK_FALSE(geometry.occluded(shadow));  // open at t_max: fails for the triangle today
+        CHECK_FALSE(prism::blocked(geometry, shadow));  // open at t_max: fails for the triangle today
         });
     }
 }
@@ -971,26 +971,26 @@ TEST_CASE_TEMPLATE("SceneGeometry: back-face culling skips surfaces facing away,
     const prism::Ray<Real> from_behind{prism::Vec3<Real>(0, 0, -10), prism::Vec3<Real>(0, 0, 1)};
     prism::Hit<Real> hit;
     prism::Ray<Real> ray = from_front;
-    REQUIRE(geometry.template intersect<BackfaceCulling::all>(ray, hit));
+    REQUIRE(prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::all));
     CHECK(hit.t == Real(2));
     CHECK(hit.object == 0);
     ray = from_behind;
-    CHECK_FALSE(geometry.template intersect<BackfaceCulling::all>(ray, hit));  // both the plane and the triangle face away
+    CHECK_FALSE(prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::all));  // both the plane and the triangle face away
     ray = from_behind;
-    REQUIRE(geometry.template intersect<BackfaceCulling::none>(ray, hit));
+    REQUIRE(prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::none));
     CHECK(hit.t == Real(5));
     CHECK(hit.object == 1);  // planes are numbered after the instances
     ray = from_behind;
     ray.t_min = Real(6);
-    REQUIRE(geometry.template intersect<BackfaceCulling::none>(ray, hit));
+    REQUIRE(prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::none));
     CHECK(hit.t == Real(10));
     CHECK(hit.object == 0);
     // The course's rule skips the flat triangle but keeps the plane.
     ray = from_behind;
     ray.t_min = Real(6);
-    CHECK_FALSE(geometry.template intersect<BackfaceCulling::triangles>(ray, hit));
+    CHECK_FALSE(prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::triangles));
     ray = from_behind;
-    REQUIRE(geometry.template intersect<BackfaceCulling::triangles>(ray, hit));
+    REQUIRE(prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::triangles));
     CHECK(hit.object == 1);
     });
 }
@@ -1015,16 +1015,16 @@ TEST_CASE_TEMPLATE("SceneGeometry: the course's culling skips smooth meshes too 
         prism::Ray<Real> ray = from_behind;
         // From behind both triangles face away: the smooth one (t = 9) is skipped as the flat
         // one is; without culling it is met first.
-        CHECK_FALSE(geometry.template intersect<BackfaceCulling::triangles>(ray, hit));
+        CHECK_FALSE(prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::triangles));
         ray = from_behind;
-        CHECK_FALSE(geometry.template intersect<BackfaceCulling::all>(ray, hit));
+        CHECK_FALSE(prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::all));
         ray = from_behind;
-        REQUIRE(geometry.template intersect<BackfaceCulling::none>(ray, hit));
+        REQUIRE(prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::none));
         CHECK(hit.t == Real(9));
         CHECK(hit.object == 1);
         // From the front, nothing is culled: the flat triangle at t = 10 is nearer.
         ray = from_front;
-        REQUIRE(geometry.template intersect<BackfaceCulling::triangles>(ray, hit));
+        REQUIRE(prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::triangles));
         CHECK(hit.t == Real(10));
         CHECK(hit.object == 0);
     }
@@ -1036,13 +1036,13 @@ TEST_CASE_TEMPLATE("SceneGeometry: the course's culling skips smooth meshes too 
     world.mesh_instances.push_back({"turned", 0, 0, turned, {}, {}});
     const BvhGeometry<Real> geometry(world);
     prism::Ray<Real> ray = from_behind;
-    REQUIRE(geometry.template intersect<BackfaceCulling::triangles>(ray, hit));
+    REQUIRE(prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::triangles));
     CHECK(hit.t == doctest::Approx(11).epsilon(1e-6));
     ray = from_front;
-    REQUIRE(geometry.template intersect<BackfaceCulling::triangles>(ray, hit));
+    REQUIRE(prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::triangles));
     CHECK(hit.t == doctest::Approx(10).epsilon(1e-6));
     ray = from_front;
-    REQUIRE(geometry.template intersect<BackfaceCulling::none>(ray, hit));
+    REQUIRE(prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::none));
     CHECK(hit.t == doctest::Approx(9).epsilon(1e-6));
 }
 

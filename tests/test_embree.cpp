@@ -63,7 +63,7 @@ Agreement<Real> compare_answers(const scene::Scene& world, int grid) {
             prism::Ray<Real> a = camera.ray(Real(x) + Real(0.5), Real(y) + Real(0.5), prism::Vec2<Real>(Real(0.5)), Real(0));
             prism::Ray<Real> b = a;
             prism::Hit<Real> hit_a, hit_b;
-            const bool found_a = own.intersect(a, hit_a), found_b = embree.intersect(b, hit_b);
+            const bool found_a = prism::closest_hit(own, a, hit_a), found_b = prism::closest_hit(embree, b, hit_b);
             ++result.rays;
             // (primitive numbers differ: prism's BVH reorders a mesh's triangles, Embree's
             // scene keeps the file's order; the barycentrics say it is the same triangle.)
@@ -80,7 +80,7 @@ Agreement<Real> compare_answers(const scene::Scene& world, int grid) {
             const prism::Vec3<Real> origin = own.spawn_origin(point, up);
             const prism::Ray<Real> shadow{origin, up, Real(0), Real(1e3)};
             ++result.rays;
-            if (own.occluded(shadow) != embree.occluded(shadow)) ++result.disagreements;
+            if (prism::blocked(own, shadow) != prism::blocked(embree, shadow)) ++result.disagreements;
         }
     return result;
 }

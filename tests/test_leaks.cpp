@@ -164,7 +164,7 @@ CaseResult run_case(const LeakCase& c, int rays, std::uint64_t seed) {
         if (ray.direction == Vec3(0)) continue;
         ++result.rays;
         prism::Hit<Real> hit;
-        if (!geometry.intersect(ray, hit)) ++result.misses;
+        if (!prism::closest_hit(geometry, ray, hit)) ++result.misses;
     }
     return result;
 }

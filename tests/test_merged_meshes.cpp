@@ -90,7 +90,7 @@ void compare_with_brute_force(const scene::Scene& world) {
         prism::Ray<Real> ray = start, reference_ray = start;
         prism::Hit<Real> hit, reference;
         ++rays;
-        if (!merged.intersect(ray, hit) || !brute.intersect(reference_ray, reference)) {
+        if (!prism::closest_hit(merged, ray, hit) || !prism::closest_hit(brute, reference_ray, reference)) {
             ++differ;
             return;
         }
@@ -109,9 +109,9 @@ void compare_with_brute_force(const scene::Scene& world) {
             ++differ;
         prism::Ray<Real> shadow = start;
         shadow.t_max = Real(0.0625);
-        if (merged.occluded(shadow)) ++occluded_wrong;
+        if (prism::blocked(merged, shadow)) ++occluded_wrong;
         shadow.t_max = Real(1);
-        if (!merged.occluded(shadow)) ++occluded_wrong;
+        if (!prism::blocked(merged, shadow)) ++occluded_wrong;
     };
     const glm::dvec3 instance_offset(-10, 0, 0);  // the instance's place relative to its mesh's
     for (std::uint32_t m = 0; m < world.meshes.size(); ++m) {
@@ -131,12 +131,12 @@ void compare_with_brute_force(const scene::Scene& world) {
     // The sphere, in the top level beside the merged index.
     prism::Ray<Real> ray{prism::Vec3<Real>(2, 2, 10), prism::Vec3<Real>(0, 0, -1)};
     prism::Hit<Real> hit;
-    REQUIRE(merged.intersect(ray, hit));
+    REQUIRE(prism::closest_hit(merged, ray, hit));
     CHECK(hit.object == world.meshes.size() + 1);
     CHECK(hit.t == doctest::Approx(4.5).epsilon(1e-6));
     // Below the sphere a ray meets the merged grids, the nearest at z = 1 (mesh 3).
     ray = {prism::Vec3<Real>(2.1, 2.1, 4), prism::Vec3<Real>(0, 0, -1)};
-    REQUIRE(merged.intersect(ray, hit));
+    REQUIRE(prism::closest_hit(merged, ray, hit));
     CHECK(hit.object == 3);
     CHECK(hit.t == doctest::Approx(3).epsilon(1e-6));
 }
@@ -177,11 +177,11 @@ TEST_CASE_TEMPLATE("Merged world-space meshes: back-face culling skips flat and 
         prism::Hit<Real> hit;
         bool found = false;
         switch (culling) {
-            case BackfaceCulling::none: found = geometry.template intersect<BackfaceCulling::none>(ray, hit); break;
+            case BackfaceCulling::none: found = prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::none); break;
             case BackfaceCulling::triangles:
-                found = geometry.template intersect<BackfaceCulling::triangles>(ray, hit);
+                found = prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::triangles);
                 break;
-            case BackfaceCulling::all: found = geometry.template intersect<BackfaceCulling::all>(ray, hit); break;
+            case BackfaceCulling::all: found = prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::all); break;
         }
         return found ? std::pair<int, Real>(int(hit.object), hit.t) : std::pair<int, Real>(-1, Real(0));
     };
@@ -206,9 +206,9 @@ TEST_CASE_TEMPLATE("Merged world-space meshes: back-face culling skips flat and 
         // Shadow rays cull nothing.
         prism::Ray<Real> shadow = from_above;
         shadow.t_min = Real(12.5);
-        CHECK(geometry.occluded(shadow));
+        CHECK(prism::blocked(geometry, shadow));
         shadow.t_max = Real(12.9);
-        CHECK_FALSE(geometry.occluded(shadow));
+        CHECK_FALSE(prism::blocked(geometry, shadow));
     };
     check.template operator()<prism::SceneGeometry<Real, prism::Bvh<prism::Watertight>>>();
     check.template operator()<prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 4>>>();
@@ -231,12 +231,12 @@ TEST_CASE_TEMPLATE("Merged world-space meshes: moving meshes stay in the top lev
     prism::Ray<Real> ray{prism::Vec3<Real>(0.75, 0.25, 4), prism::Vec3<Real>(0, 0, -1)};
     ray.time = Real(1);
     prism::Hit<Real> hit;
-    REQUIRE(moving.intersect(ray, hit));
+    REQUIRE(prism::closest_hit(moving, ray, hit));
     CHECK(hit.object == 1);
     CHECK(hit.t == Real(1));
     ray = {prism::Vec3<Real>(0.75, 0.25, 4), prism::Vec3<Real>(0, 0, -1), Real(1.5)};
     ray.time = Real(1);
-    REQUIRE(moving.intersect(ray, hit));
+    REQUIRE(prism::closest_hit(moving, ray, hit));
     CHECK(hit.object == 0);
     CHECK(hit.t == Real(4));
 }

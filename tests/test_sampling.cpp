@@ -204,7 +204,7 @@ TEST_CASE_TEMPLATE("Motion blur: the box covers the sweep, rays meet the object 
         prism::Ray<Real> at_object{prism::Vec3<Real>(Real(x), 0, 5), prism::Vec3<Real>(0, 0, -1), Real(0),
                                    prism::infinity<Real>, Real(time)};
         prism::Hit<Real> hit;
-        REQUIRE(geometry.intersect(at_object, hit));
+        REQUIRE(prism::closest_hit(geometry, at_object, hit));
         CHECK(double(hit.t) == doctest::Approx(4));
         // The surface point's object-space position is where the unmoved sphere was hit.
         const prism::SurfacePoint<Real> point = geometry.surface(at_object, hit);
@@ -213,7 +213,7 @@ TEST_CASE_TEMPLATE("Motion blur: the box covers the sweep, rays meet the object 
         // Where the sphere was at another instant, the ray passes through empty space.
         prism::Ray<Real> elsewhere = at_object;
         elsewhere.time = Real(time < 0.5 ? 1.0 : 0.0);
-        CHECK_FALSE(geometry.occluded(elsewhere));
+        CHECK_FALSE(prism::blocked(geometry, elsewhere));
     }
 }
 
@@ -367,7 +367,8 @@ TEST_CASE_TEMPLATE("Renderer: a row's mirrors and conductors, their reflections 
     for (const bool indexed : {false, true}) {
         CAPTURE(indexed);
         if (indexed) world.meshes.push_back(tent);
-        REQUIRE(prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>(world).intersection_batches() == !indexed);
+        REQUIRE((prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>(world).route() == prism::BatchRoute::leaf_lanes) ==
+                !indexed);
         world.max_recursion_depth = 0;
         const prism::Image unreflected = prism::Renderer<Punctual>(world).render(world.cameras[0]);
         std::optional<prism::Image> once;
@@ -652,7 +653,7 @@ TEST_CASE_TEMPLATE("SceneGeometry::surface: without (u, v) and tangents, without
         CAPTURE(r);
         prism::Ray<Real> ray = rays[r];
         prism::Hit<Real> hit;
-        REQUIRE(geometry.intersect(ray, hit));
+        REQUIRE(prism::closest_hit(geometry, ray, hit));
         const prism::SurfacePoint<Real> full = geometry.surface(ray, hit);
         const prism::SurfacePoint<Real> bare = geometry.template surface<false>(ray, hit);
         const prism::SurfacePoint<Real> unspawned = geometry.surface(ray, hit, false);

@@ -587,7 +587,7 @@ InstancedCounts reintersect_instanced(int triangle_count, int rays_per_triangle,
             prism::Ray<Real> incoming{origin, Vec3(target) - origin, Real(0), prism::infinity<Real>};
             if (incoming.direction == Vec3(0)) continue;
             prism::Hit<Real> hit;
-            if (!geometry.intersect(incoming, hit)) continue;
+            if (!prism::closest_hit(geometry, incoming, hit)) continue;
             ++counts.incoming_hits;
             const prism::PointWithError<Real> object_point =
                 prism::triangle_spawn_point(stored[0], stored[1], stored[2], hit.b1, hit.b2);
@@ -598,7 +598,7 @@ InstancedCounts reintersect_instanced(int triangle_count, int rays_per_triangle,
                 prism::Hit<Real> again;
                 prism::Ray<Real> leaving{prism::offset_ray_origin(instance, object_point, object_normal, direction),
                                          direction, Real(0), prism::infinity<Real>};
-                if (geometry.intersect(leaving, again)) ++counts.instance_rehits;
+                if (prism::closest_hit(geometry, leaving, again)) ++counts.instance_rehits;
                 // The origin the traversal sees: SceneGeometry's own world-to-object mapping.
                 const Vec3 seen = Vec3(instance.world_to_object * prism::Vec4<Real>(leaving.origin, Real(1)));
                 const Wide chosen_side =
@@ -606,7 +606,7 @@ InstancedCounts reintersect_instanced(int triangle_count, int rays_per_triangle,
                 if (!(chosen_side * wide_dot(widen(seen) - widen(p0), exact_normal) > 0)) ++counts.origins_behind;
                 prism::Ray<Real> world_leaving{prism::offset_ray_origin(world_point, world_normal, direction), direction,
                                                Real(0), prism::infinity<Real>};
-                if (geometry.intersect(world_leaving, again)) ++counts.world_rehits;
+                if (prism::closest_hit(geometry, world_leaving, again)) ++counts.world_rehits;
             }
         }
     }
@@ -656,7 +656,7 @@ TEST_CASE_TEMPLATE("spawn_side: rays leaving one point by the same side get the 
         const glm::dvec3 from = target + 40.0 * random_unit_vector(rng);
         prism::Ray<Real> ray{prism::Vec3<Real>(from), prism::Vec3<Real>(glm::normalize(target - from))};
         prism::Hit<Real> hit;
-        if (!geometry.intersect(ray, hit)) continue;
+        if (!prism::closest_hit(geometry, ray, hit)) continue;
         ++points;
         const prism::SurfacePoint<Real> point = geometry.surface(ray, hit);
         std::array<std::optional<prism::Vec3<Real>>, 4> first;

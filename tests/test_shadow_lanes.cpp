@@ -223,8 +223,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: shadow rays side by side through the index ge
         CAPTURE(moving);
         const scene::Scene world = index_scene(moving);
         const auto check = [&](const auto& geometry) {
-            REQUIRE_FALSE(geometry.occlusion_batches());
-            REQUIRE_FALSE(geometry.intersection_batches());
+            REQUIRE(geometry.route() == prism::BatchRoute::index_lanes);
             std::mt19937 random(moving ? 5 : 4);
             std::uniform_real_distribution<double> uniform(-1, 1), fraction(0, 1);
             std::size_t rays = 0, blocked_rays = 0;
@@ -242,7 +241,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: shadow rays side by side through the index ge
                                                     prism::Vec3<Real>(glm::normalize(glm::dvec3(-0.5 + double(i) / count, -0.3 + 0.1 * uniform(random), -1))),
                                                     Real(0), prism::infinity<Real>, time};
                         prism::Hit<Real> hit;
-                        if (geometry.intersect(camera_ray, hit))
+                        if (prism::closest_hit(geometry, camera_ray, hit))
                             from = glm::dvec3(camera_ray.origin + camera_ray.direction * hit.t) + 1e-3 * random_unit(random);
                     }
                     glm::dvec3 direction = glm::normalize(light - from);
@@ -256,8 +255,8 @@ TEST_CASE_TEMPLATE("SceneGeometry: shadow rays side by side through the index ge
                 }
                 std::uint32_t expected = 0;
                 for (int i = 0; i < count; ++i)
-                    if (geometry.occluded(shadows[std::size_t(i)])) expected |= std::uint32_t(1) << i;
-                CHECK(geometry.occluded_side_by_side(shadows.data(), count) == expected);
+                    if (prism::blocked(geometry, shadows[std::size_t(i)])) expected |= std::uint32_t(1) << i;
+                CHECK(geometry.occluded(prism::RayBatch<Real>::all(shadows.data(), count)) == expected);
                 rays += std::size_t(count);
                 blocked_rays += std::size_t(std::popcount(expected));
             }
@@ -280,7 +279,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: an index scene's one-leaf world mesh gives th
     const scene::Scene world = index_scene(false);
     const prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>> indexed(world);
     const prism::SceneGeometry<Real, prism::BruteForce<prism::Watertight>> brute(world);
-    REQUIRE_FALSE(indexed.intersection_batches());
+    REQUIRE(indexed.route() == prism::BatchRoute::index_lanes);
     std::mt19937 random(9);
     std::uniform_real_distribution<double> uniform(-1, 1);
     std::size_t floor_hits = 0, differ = 0;
@@ -294,10 +293,10 @@ TEST_CASE_TEMPLATE("SceneGeometry: an index scene's one-leaf world mesh gives th
         for (const BackfaceCulling culling : {BackfaceCulling::none, BackfaceCulling::all}) {
             prism::Ray<Real> a = start, b = start;
             prism::Hit<Real> hit_a, hit_b;
-            const bool found_a = culling == BackfaceCulling::none ? indexed.template intersect<BackfaceCulling::none>(a, hit_a)
-                                                                  : indexed.template intersect<BackfaceCulling::all>(a, hit_a);
-            const bool found_b = culling == BackfaceCulling::none ? brute.template intersect<BackfaceCulling::none>(b, hit_b)
-                                                                  : brute.template intersect<BackfaceCulling::all>(b, hit_b);
+            const bool found_a = culling == BackfaceCulling::none ? prism::closest_hit(indexed, a, hit_a, prism::BackfaceCulling::none)
+                                                                  : prism::closest_hit(indexed, a, hit_a, prism::BackfaceCulling::all);
+            const bool found_b = culling == BackfaceCulling::none ? prism::closest_hit(brute, b, hit_b, prism::BackfaceCulling::none)
+                                                                  : prism::closest_hit(brute, b, hit_b, prism::BackfaceCulling::all);
             if (found_a != found_b || (found_a && (hit_a.object != hit_b.object || !same_bits(hit_a.t, hit_b.t)))) {
                 // Only the floor is compared exactly; elsewhere the two may differ on ties.
                 if ((found_a && hit_a.object == floor_object) || (found_b && hit_b.object == floor_object)) ++differ;
@@ -342,7 +341,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: camera rays side by side through the index ge
                 }
         }
         const auto check = [&](const auto& geometry) {
-            REQUIRE_FALSE(geometry.intersection_batches());
+            REQUIRE(geometry.route() == prism::BatchRoute::index_lanes);
             std::mt19937 random(moving ? 15 : 14);
             std::uniform_real_distribution<double> uniform(-1, 1), fraction(0, 1);
             std::size_t rays = 0, hit_rays = 0, edge_hits = 0, differ = 0;
@@ -373,9 +372,9 @@ TEST_CASE_TEMPLATE("SceneGeometry: camera rays side by side through the index ge
                     std::vector<prism::Hit<Real>> hits_alone(static_cast<std::size_t>(count)), hits_together(static_cast<std::size_t>(count));
                     std::uint32_t expected = 0;
                     for (int i = 0; i < count; ++i)
-                        if (geometry.template intersect<Culling>(alone[std::size_t(i)], hits_alone[std::size_t(i)]))
+                        if (prism::closest_hit(geometry, alone[std::size_t(i)], hits_alone[std::size_t(i)], Culling))
                             expected |= std::uint32_t(1) << i;
-                    const std::uint32_t found = geometry.template intersect_each<Culling>(together.data(), hits_together.data(), count);
+                    const std::uint32_t found = geometry.intersect(prism::RayBatch<Real>::all(together.data(), count, Culling), hits_together.data());
                     differ += found != expected;
                     for (int i = 0; i < count; ++i) {
                         const auto& a = hits_alone[std::size_t(i)];

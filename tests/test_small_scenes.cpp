@@ -122,16 +122,16 @@ TEST_CASE_TEMPLATE("SceneGeometry: a top level of a few spheres tested directly 
             prism::Ray<Real> a = ray, b = ray;
             prism::Hit<Real> hit_a, hit_b;
             const bool found_a = culling == prism::BackfaceCulling::none
-                                     ? direct.intersect(a, hit_a)
-                                     : direct.template intersect<prism::BackfaceCulling::triangles>(a, hit_a);
+                                     ? prism::closest_hit(direct, a, hit_a)
+                                     : prism::closest_hit(direct, a, hit_a, prism::BackfaceCulling::triangles);
             const bool found_b = culling == prism::BackfaceCulling::none
-                                     ? indexed.intersect(b, hit_b)
-                                     : indexed.template intersect<prism::BackfaceCulling::triangles>(b, hit_b);
+                                     ? prism::closest_hit(indexed, b, hit_b)
+                                     : prism::closest_hit(indexed, b, hit_b, prism::BackfaceCulling::triangles);
             REQUIRE(found_a == found_b);
-            CHECK(direct.occluded(ray) == indexed.occluded(ray));
+            CHECK(prism::blocked(direct, ray) == prism::blocked(indexed, ray));
             if (!found_a) continue;
             ++hits;
-            blocked += direct.occluded(ray);
+            blocked += prism::blocked(direct, ray);
             CHECK(same_bits(hit_a.t, hit_b.t));
             CHECK(same_bits(a.t_max, b.t_max));
             // Planes are numbered after the objects, so past the far spheres in the indexed scene.
@@ -270,18 +270,18 @@ TEST_CASE_TEMPLATE("SceneGeometry: tiny world-space meshes tested without their 
             prism::Hit<Real> hit_a, hit_b;
             const auto closest = [&](const Geometry& geometry, prism::Ray<Real>& r, prism::Hit<Real>& hit) {
                 switch (culling) {
-                    case prism::BackfaceCulling::none: return geometry.intersect(r, hit);
+                    case prism::BackfaceCulling::none: return prism::closest_hit(geometry, r, hit);
                     case prism::BackfaceCulling::triangles:
-                        return geometry.template intersect<prism::BackfaceCulling::triangles>(r, hit);
-                    default: return geometry.template intersect<prism::BackfaceCulling::all>(r, hit);
+                        return prism::closest_hit(geometry, r, hit, prism::BackfaceCulling::triangles);
+                    default: return prism::closest_hit(geometry, r, hit, prism::BackfaceCulling::all);
                 }
             };
             const bool found_a = closest(direct, a, hit_a), found_b = closest(indexed, b, hit_b);
             REQUIRE(found_a == found_b);
-            if (culling == prism::BackfaceCulling::none) CHECK(direct.occluded(ray) == indexed.occluded(ray));
+            if (culling == prism::BackfaceCulling::none) CHECK(prism::blocked(direct, ray) == prism::blocked(indexed, ray));
             if (!found_a) continue;
             ++hits;
-            blocked += direct.occluded(ray);
+            blocked += prism::blocked(direct, ray);
             CHECK(same_bits(hit_a.t, hit_b.t));
             CHECK(same_bits(a.t_max, b.t_max));
             CHECK(same_bits(hit_a.b1, hit_b.b1));
@@ -346,8 +346,8 @@ TEST_CASE_TEMPLATE("SceneGeometry: planes tested eight at a time find what one a
             }
             prism::Ray<Real> found_ray = ray;
             prism::Hit<Real> hit;
-            const bool found = cull ? geometry.template intersect<prism::BackfaceCulling::all>(found_ray, hit)
-                                    : geometry.intersect(found_ray, hit);
+            const bool found = cull ? prism::closest_hit(geometry, found_ray, hit, prism::BackfaceCulling::all)
+                                    : prism::closest_hit(geometry, found_ray, hit);
             REQUIRE(found == expected);
             CHECK(same_bits(found_ray.t_max, expected_ray.t_max));
             if (found) {
@@ -361,7 +361,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: planes tested eight at a time find what one a
             Real t;
             blocked |= plane.intersect(ray, ray.t_min, ray.t_max, t) && t < ray.t_max;
         }
-        CHECK(geometry.occluded(ray) == blocked);
+        CHECK(prism::blocked(geometry, ray) == blocked);
     }
     CHECK(hits > rays / 2);
 }
@@ -526,11 +526,11 @@ TEST_CASE_TEMPLATE("SceneGeometry: a world-space index whose root has two leaves
             prism::Ray<Real> a = ray, b = ray;
             prism::Hit<Real> hit_a, hit_b;
             // As a camera ray (depth 0) under `culling`.
-            const bool found_a = prism::intersect_culled(direct, culling, 0, a, hit_a);
-            const bool found_b = prism::intersect_culled(indexed, culling, 0, b, hit_b);
+            const bool found_a = prism::closest_hit(direct, a, hit_a, culling);
+            const bool found_b = prism::closest_hit(indexed, b, hit_b, culling);
             REQUIRE(found_a == found_b);
-            const bool occluded = direct.occluded(ray);
-            CHECK(occluded == indexed.occluded(ray));
+            const bool occluded = prism::blocked(direct, ray);
+            CHECK(occluded == prism::blocked(indexed, ray));
             if (!found_a) continue;
             ++hits;
             blocked += occluded;
@@ -560,7 +560,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: shadow rays tested several at a time get what
         CAPTURE(kind);
         const scene::Scene world = kind == 2 ? tiny_meshes() : few_spheres(kind == 1, kind == 1);
         const Geometry geometry(world);
-        REQUIRE(geometry.occlusion_batches());
+        REQUIRE(geometry.route() != prism::BatchRoute::index_lanes);
 
         std::mt19937 random(11);
         std::uniform_real_distribution<double> uniform(-1, 1), fraction(0, 1);
@@ -594,10 +594,10 @@ TEST_CASE_TEMPLATE("SceneGeometry: shadow rays tested several at a time get what
             std::uint32_t expected = 0;
             for (std::uint32_t rest = lanes; rest != 0; rest &= rest - 1) {
                 const int lane = std::countr_zero(rest);
-                if (geometry.occluded(shadows[std::size_t(lane)])) expected |= std::uint32_t(1) << lane;
+                if (prism::blocked(geometry, shadows[std::size_t(lane)])) expected |= std::uint32_t(1) << lane;
                 ++rays;
             }
-            CHECK(geometry.occluded_each(shadows.data(), lanes) == expected);
+            CHECK(geometry.occluded(prism::RayBatch<Real>{shadows.data(), 8, lanes}) == expected);
             // The lit rays side by side (a row's shadow rays to one light): the same answers.
             std::array<prism::Ray<Real>, 8> packed;
             int packed_count = 0;
@@ -607,7 +607,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: shadow rays tested several at a time get what
                 if ((expected >> lane) & 1) packed_expected |= std::uint32_t(1) << packed_count;
                 packed[std::size_t(packed_count++)] = shadows[std::size_t(lane)];
             }
-            CHECK(geometry.occluded_side_by_side(packed.data(), packed_count) == packed_expected);
+            CHECK(geometry.occluded(prism::RayBatch<Real>::all(packed.data(), packed_count)) == packed_expected);
             blocked += std::size_t(std::popcount(expected));
         }
         // Both answers are common: the comparison is not of misses (or of hits) alone.
@@ -636,26 +636,20 @@ TEST_CASE_TEMPLATE("SceneGeometry: camera rays tested several at a time get what
         const Geometry geometry(world);
         // Side by side where the top level holds spheres alone; the transformed plates of
         // tiny_meshes keep intersect's own path, which intersect_each must then give too.
-        REQUIRE(geometry.intersection_batches() == (kind != 3));
+        REQUIRE((geometry.route() == prism::BatchRoute::leaf_lanes) == (kind != 3));
 
         std::mt19937 random(23);
         std::uniform_real_distribution<double> uniform(-1, 1), fraction(0, 1);
         const auto intersect = [&](BackfaceCulling culling, prism::Ray<Real>& ray, prism::Hit<Real>& hit) {
             switch (culling) {
-                case BackfaceCulling::none: return geometry.template intersect<BackfaceCulling::none>(ray, hit);
-                case BackfaceCulling::triangles: return geometry.template intersect<BackfaceCulling::triangles>(ray, hit);
+                case BackfaceCulling::none: return prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::none);
+                case BackfaceCulling::triangles: return prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::triangles);
                 case BackfaceCulling::all: break;
             }
-            return geometry.template intersect<BackfaceCulling::all>(ray, hit);
+            return prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::all);
         };
         const auto intersect_each = [&](BackfaceCulling culling, prism::Ray<Real>* rays, prism::Hit<Real>* hits, int count) {
-            switch (culling) {
-                case BackfaceCulling::none: return geometry.template intersect_each<BackfaceCulling::none>(rays, hits, count);
-                case BackfaceCulling::triangles:
-                    return geometry.template intersect_each<BackfaceCulling::triangles>(rays, hits, count);
-                case BackfaceCulling::all: break;
-            }
-            return geometry.template intersect_each<BackfaceCulling::all>(rays, hits, count);
+            return geometry.intersect(prism::RayBatch<Real>::all(rays, count, culling), hits);
         };
         std::size_t rays_tested = 0, hits_found = 0;
         std::array<std::size_t, 3> kinds_hit{};  // spheres, triangles, planes
@@ -690,8 +684,8 @@ TEST_CASE_TEMPLATE("SceneGeometry: camera rays tested several at a time get what
             // The same rays as shadow rays, side by side (occluded_side_by_side).
             std::uint32_t blocked = 0;
             for (int i = 0; i < count; ++i)
-                if (geometry.occluded(rays[std::size_t(i)])) blocked |= std::uint32_t(1) << i;
-            CHECK(geometry.occluded_side_by_side(rays.data(), count) == blocked);
+                if (prism::blocked(geometry, rays[std::size_t(i)])) blocked |= std::uint32_t(1) << i;
+            CHECK(geometry.occluded(prism::RayBatch<Real>::all(rays.data(), count)) == blocked);
             std::array<prism::Hit<Real>, 16> hits, each_hits;
             const std::uint32_t found = intersect_each(culling, each.data(), each_hits.data(), count);
             for (int i = 0; i < count; ++i) {

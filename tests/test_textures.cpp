@@ -456,7 +456,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: textures live in a mesh's object space and in
     const auto surface_at = [&](Vec3<Real> origin) {
         Ray<Real> ray{origin, Vec3<Real>(0, 0, -1), Real(0), infinity<Real>, Real(0)};
         Hit<Real> hit;
-        REQUIRE(geometry.intersect(ray, hit));
+        REQUIRE(prism::closest_hit(geometry, ray, hit));
         return geometry.surface(ray, hit);
     };
     // The square, hit at world (-0.02, 0.03): object (0.4, 0.6, 0), and its transformation's
@@ -494,7 +494,7 @@ TEST_CASE_TEMPLATE("Mesh bump: the tangent frame from a triangle's texture coord
         const SceneGeometry<Real, Bvh<Watertight>, false> geometry(scene);
         Ray<Real> ray{origin, Vec3<Real>(0, 0, -1), Real(0), infinity<Real>, Real(0)};
         Hit<Real> hit;
-        REQUIRE(geometry.intersect(ray, hit));
+        REQUIRE(prism::closest_hit(geometry, ray, hit));
         SurfacePoint<Real> point = geometry.surface(ray, hit);
         Material<Real> material(grey_material());
         TextureSet<Real>(scene).apply(point, material);

@@ -6,6 +6,7 @@
 #include <prism/accel/bvh_tree.hpp>
 #include <prism/accel/primitive_list.hpp>
 #include <prism/accel/wide_bvh_tree.hpp>
+#include <prism/geometry/ray_batch.hpp>
 #include <prism/geometry/triangle_hit.hpp>
 #include <prism/geometry/watertight.hpp>
 
@@ -13,8 +14,6 @@
 #include <span>
 
 namespace prism {
-
-template <Scalar Real> struct Hit;
 
 // A spatial index over boxes, traversed with a leaf callback (BvhTree, PrimitiveList).
 template <class I, class Real>
@@ -26,11 +25,12 @@ concept SpatialIndex = Scalar<Real> && requires(const I& index, std::span<const 
     { index.traverse_any(ray, t, [](std::uint32_t, std::uint32_t, Real&) { return true; }) } -> std::same_as<bool>;
 };
 
+// What finds hits: the query seam's two entries (geometry/ray_batch.hpp), closest hits and any
+// hits of a batch of rays.
 template <class A, class Real>
-concept Accelerator = Scalar<Real> && requires(const A& accel, Ray<Real>& ray, const Ray<Real>& shadow_ray,
-                                               Hit<Real>& hit) {
-    { accel.intersect(ray, hit) } -> std::same_as<bool>;
-    { accel.occluded(shadow_ray) } -> std::same_as<bool>;
+concept Accelerator = Scalar<Real> && requires(const A& accel, const RayBatch<Real>& batch, Hit<Real>* hits) {
+    { accel.intersect(batch, hits) } -> std::same_as<std::uint32_t>;
+    { accel.occluded(batch) } -> std::same_as<std::uint32_t>;
 };
 
 template <class IntersectorT = Watertight>

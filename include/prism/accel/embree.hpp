@@ -14,11 +14,13 @@
 #pragma once
 
 #include <prism/accel/accelerator.hpp>
+#include <prism/geometry/ray_batch.hpp>
 #include <prism/geometry/scene_geometry.hpp>
 
 #include <embree3/rtcore.h>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -95,9 +97,54 @@ public:
     std::size_t triangle_count() const { return shapes_.triangle_count(); }
     Aabb<Real> bounds() const { return shapes_.bounds(); }
 
+    // The query seam's two entries (geometry/ray_batch.hpp), each active ray queried on its own:
+    // Embree's single-ray queries, with prism's own test on the primitive Embree finds.
+    std::uint32_t intersect(const RayBatch<Real>& batch, Hit<Real>* hits) const {
+        std::uint32_t found = 0;
+        for (std::uint32_t lanes = batch.active; lanes != 0; lanes &= lanes - 1) {
+            const int i = std::countr_zero(lanes);
+            bool hit = false;
+            switch (batch.culling) {
+                case BackfaceCulling::none: hit = closest_one<BackfaceCulling::none>(batch.rays[i], hits[i]); break;
+                case BackfaceCulling::triangles:
+                    hit = closest_one<BackfaceCulling::triangles>(batch.rays[i], hits[i]);
+                    break;
+                case BackfaceCulling::all: hit = closest_one<BackfaceCulling::all>(batch.rays[i], hits[i]); break;
+            }
+            if (hit) found |= std::uint32_t(1) << i;
+        }
+        return found;
+    }
+    std::uint32_t occluded(const RayBatch<Real>& batch) const {
+        std::uint32_t blocked = 0;
+        for (std::uint32_t lanes = batch.active; lanes != 0; lanes &= lanes - 1) {
+            const int i = std::countr_zero(lanes);
+            if (occluded_one(batch.rays[i])) blocked |= std::uint32_t(1) << i;
+        }
+        return blocked;
+    }
+
+    // What a hit means is prism's own (SceneGeometry's surfaces).
+    template <bool Parametrised = true>
+    SurfacePoint<Real> surface(const Ray<Real>& ray, const Hit<Real>& hit, bool spawn_point = true) const {
+        return shapes_.template surface<Parametrised>(ray, hit, spawn_point);
+    }
+    Vec3<Real> emitted(std::uint32_t object) const { return shapes_.emitted(object); }
+    Vec3<Real> spawn_origin(const SurfacePoint<Real>& point, const Vec3<Real>& direction) const {
+        return shapes_.spawn_origin(point, direction);
+    }
+    int spawn_side(const SurfacePoint<Real>& point, const Vec3<Real>& direction) const {
+        return shapes_.spawn_side(point, direction);
+    }
+
+    // Bytes Embree holds for this scene (its BVHs and copies of the triangles), as its memory
+    // monitor counted them during the build.
+    std::int64_t embree_bytes() const { return device_.bytes(); }
+
+private:
     // Closest hit in (ray.t_min, ray.t_max]; on a hit, ray.t_max becomes the hit distance.
-    template <BackfaceCulling Culling = BackfaceCulling::none>
-    bool intersect(Ray<Real>& ray, Hit<Real>& hit) const {
+    template <BackfaceCulling Culling>
+    bool closest_one(Ray<Real>& ray, Hit<Real>& hit) const {
         RTCRayHit ray_hit;
         ray_hit.ray = embree_ray(ray, ray.t_max);
         ray_hit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -121,7 +168,7 @@ public:
     }
 
     // Whether anything lies in (ray.t_min, ray.t_max): open at t_max, like prism's own.
-    bool occluded(const Ray<Real>& ray) const {
+    bool occluded_one(const Ray<Real>& ray) const {
         RTCRay embree = embree_ray(ray, ray.t_max);
         // Open at t_max: in float Embree's closed interval is shortened by an ulp; in double
         // prism's test in the filter decides, so Embree's interval must not end early.
@@ -134,17 +181,6 @@ public:
         return embree.tfar == -std::numeric_limits<float>::infinity() || shapes_.occluded_by_planes(ray);
     }
 
-    SurfacePoint<Real> surface(const Ray<Real>& ray, const Hit<Real>& hit) const { return shapes_.surface(ray, hit); }
-    Vec3<Real> emitted(std::uint32_t object) const { return shapes_.emitted(object); }
-    Vec3<Real> spawn_origin(const SurfacePoint<Real>& point, const Vec3<Real>& direction) const {
-        return shapes_.spawn_origin(point, direction);
-    }
-
-    // Bytes Embree holds for this scene (its BVHs and copies of the triangles), as its memory
-    // monitor counted them during the build.
-    std::int64_t embree_bytes() const { return device_.bytes(); }
-
-private:
     // Embree's handles, released in order (scene before device).
     struct DeviceHandle {
         RTCDevice device = nullptr;

@@ -42,20 +42,4 @@ enum class BackfaceCulling {
     all,        // camera rays skip every back-facing triangle and plane
 };
 
-// The closest hit for an integrator: camera rays (depth 0) skip back faces as `culling` says,
-// every other ray sees both sides. One place, so the ray tracer and the path tracer see the same
-// first surfaces. Inlined into the integrator: it is three dispatches, and a call here put one
-// more call and its spills on every ray of the small scenes (SceneGeometry::intersect).
-template <class Geometry, class RayT, class HitT>
-[[gnu::always_inline]] inline bool intersect_culled(const Geometry& geometry, BackfaceCulling culling, int depth, RayT& ray, HitT& hit) {
-    if (depth == 0) {
-        switch (culling) {
-            case BackfaceCulling::none: break;
-            case BackfaceCulling::triangles: return geometry.template intersect<BackfaceCulling::triangles>(ray, hit);
-            case BackfaceCulling::all: return geometry.template intersect<BackfaceCulling::all>(ray, hit);
-        }
-    }
-    return geometry.template intersect<BackfaceCulling::none>(ray, hit);
-}
-
 }  // namespace prism

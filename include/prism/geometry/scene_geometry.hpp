@@ -14,6 +14,7 @@
 #include <prism/accel/accelerator.hpp>
 #include <prism/geometry/backface_culling.hpp>
 #include <prism/geometry/hit.hpp>
+#include <prism/geometry/ray_batch.hpp>
 #include <prism/geometry/sphere.hpp>
 #include <prism/geometry/surface_error.hpp>
 #include <prism/geometry/triangle_mesh.hpp>
@@ -181,16 +182,57 @@ public:
     // LightSphere's (and a LightMesh instance's), zero for every other object and for planes.
     Vec3<Real> emitted(std::uint32_t object) const { return object < emitted_.size() ? emitted_[object] : Vec3<Real>(0); }
 
-    // Closest hit in (ray.t_min, ray.t_max]; on a hit, ray.t_max becomes the hit distance.
-    // `Culling` names the surfaces skipped when the ray meets them from behind
-    // (geometry/backface_culling.hpp).
-    // The small scenes' direct form is a dispatch to two out-of-line functions, and is inlined
-    // into the caller; the indexed form stays one out-of-line function. GCC weighed the two as
-    // one: once the kernel's slab test changed size it stopped inlining the whole,
-    // and every camera ray of the sphere scenes paid a call and its spills (3% of hw1
-    // simple_shading's CPU time, 8-13% of hw1 two_spheres').
-    template <BackfaceCulling Culling = BackfaceCulling::none>
-    [[gnu::always_inline]] bool intersect(Ray<Real>& ray, Hit<Real>& hit) const {
+    // The one closest-hit entry (geometry/ray_batch.hpp): for each active ray, the closest hit in
+    // (t_min, t_max], its t_max lowered to it and hits[i] filled; bit i set where rays[i] hits.
+    // The batch's culling rule names the surfaces skipped when met from behind
+    // (geometry/backface_culling.hpp). Every ray's hit is the one it gets alone, to the bit,
+    // however the batch is traversed (closest_many decides): a hit depends on the order in
+    // which leaves are visited only when two candidates tie, and a ray whose hit in a lane
+    // traversal came at exactly the t_max it was given is traced again on its own.
+    // A batch of one is inlined into the caller down to closest_one's dispatch.
+    [[gnu::always_inline]] std::uint32_t intersect(const RayBatch<Real>& batch, Hit<Real>* hits) const {
+        if (batch.count == 1) {
+            if (!(batch.active & 1)) return 0;
+            switch (batch.culling) {
+                case BackfaceCulling::none: break;
+                case BackfaceCulling::triangles: return closest_one<BackfaceCulling::triangles>(batch.rays[0], hits[0]);
+                case BackfaceCulling::all: return closest_one<BackfaceCulling::all>(batch.rays[0], hits[0]);
+            }
+            return closest_one<BackfaceCulling::none>(batch.rays[0], hits[0]);
+        }
+        return closest_many(batch, hits);
+    }
+
+    // The one any-hit entry: bit i set where something lies in (t_min, t_max) of active ray i
+    // (open at t_max: a shadow ray aimed at a point on a surface is not blocked by it).
+    [[gnu::always_inline]] std::uint32_t occluded(const RayBatch<Real>& batch) const {
+        if (batch.count == 1) return (batch.active & 1) && occluded_one(batch.rays[0]);
+        return occluded_many(batch);
+    }
+
+    // The one rule for how a batch of several rays is traversed, closest and any hits alike:
+    // with triangle packets, a scene whose direct form tests its leaves and spheres with a ray
+    // in each lane (intersection_batches) takes them so; a scene with an index (no direct form)
+    // takes up to index_lanes rays through it together (the nodes' tests of several rays then
+    // overlap instead of each waiting on the one before); elsewhere (roots of two leaves or
+    // top-level meshes tested directly, no packets) the rays go one by one.
+    BatchRoute route() const {
+        if constexpr (Mesh::packed) {
+            if (intersection_batches()) return BatchRoute::leaf_lanes;
+            if (!direct_) return BatchRoute::index_lanes;
+        }
+        return BatchRoute::ray_by_ray;
+    }
+
+
+private:
+    // One ray's closest hit. The small scenes' direct form is a dispatch to two out-of-line
+    // functions, and is inlined into the caller; the indexed form stays one out-of-line
+    // function. GCC weighed the two as one: once the kernel's slab test changed size it stopped
+    // inlining the whole, and every camera ray of the sphere scenes paid a call and its spills
+    // (3% of hw1 simple_shading's CPU time, 8-13% of hw1 two_spheres').
+    template <BackfaceCulling Culling>
+    [[gnu::always_inline]] bool closest_one(Ray<Real>& ray, Hit<Real>& hit) const {
         if (direct_) {
             const bool found = !world_meshes_.empty() && (two_leaves_ ? intersect_world_leaves<Culling, true>(ray, hit)
                                                                        : intersect_world_leaves<Culling, false>(ray, hit));
@@ -198,6 +240,79 @@ public:
         }
         return intersect_indexed<Culling>(ray, hit);
     }
+
+    // A batch of several rays, traversed as route() says: side by side, the active rays first
+    // gathered to the front if the mask has gaps (closest_dense), or ray by ray.
+    std::uint32_t closest_many(const RayBatch<Real>& batch, Hit<Real>* hits) const {
+        switch (batch.culling) {
+            case BackfaceCulling::none: break;
+            case BackfaceCulling::triangles: return closest_gathered<BackfaceCulling::triangles>(batch, hits);
+            case BackfaceCulling::all: return closest_gathered<BackfaceCulling::all>(batch, hits);
+        }
+        return closest_gathered<BackfaceCulling::none>(batch, hits);
+    }
+    template <BackfaceCulling Culling>
+    std::uint32_t closest_gathered(const RayBatch<Real>& batch, Hit<Real>* hits) const {
+        const BatchRoute way = route();
+        if (way == BatchRoute::ray_by_ray) {
+            std::uint32_t found = 0;
+            for (std::uint32_t lanes = batch.active; lanes != 0; lanes &= lanes - 1) {
+                const int i = std::countr_zero(lanes);
+                if (closest_one<Culling>(batch.rays[i], hits[i])) found |= std::uint32_t(1) << i;
+            }
+            return found;
+        }
+        if (batch.dense()) return closest_dense<Culling>(way, batch.rays, hits, batch.count);
+        Gathered gathered(batch);
+        Hit<Real> gathered_hits[RayBatch<Real>::max_rays];
+        for (int k = 0; k < gathered.count; ++k) gathered_hits[k] = hits[gathered.index[k]];
+        const std::uint32_t found = closest_dense<Culling>(way, gathered.rays, gathered_hits, gathered.count);
+        for (int k = 0; k < gathered.count; ++k) {
+            batch.rays[gathered.index[k]].t_max = gathered.rays[k].t_max;
+            hits[gathered.index[k]] = gathered_hits[k];
+        }
+        return gathered.scatter(found);
+    }
+
+    // The any-hit query of one ray.
+    [[gnu::always_inline]] bool occluded_one(const Ray<Real>& ray) const {
+        if (direct_) return occluded_without_index(ray);
+        return occluded_indexed(ray);
+    }
+    // Several rays, as route() says: side by side, or ray by ray over the active mask.
+    std::uint32_t occluded_many(const RayBatch<Real>& batch) const {
+        const BatchRoute way = route();
+        if (way == BatchRoute::ray_by_ray) {
+            std::uint32_t blocked = 0;
+            for (std::uint32_t lanes = batch.active; lanes != 0; lanes &= lanes - 1) {
+                const int lane = std::countr_zero(lanes);
+                if (occluded_one(batch.rays[lane])) blocked |= std::uint32_t(1) << lane;
+            }
+            return blocked;
+        }
+        if (batch.dense()) return occluded_dense(way, batch.rays, batch.count);
+        Gathered gathered(batch);
+        return gathered.scatter(occluded_dense(way, gathered.rays, gathered.count));
+    }
+
+    // A batch's active rays gathered to the front, for the side-by-side routes, which take
+    // rays[0, count); scatter takes an answer's bits back to the rays' own.
+    struct Gathered {
+        Ray<Real> rays[RayBatch<Real>::max_rays];
+        int index[RayBatch<Real>::max_rays];
+        int count = 0;
+        explicit Gathered(const RayBatch<Real>& batch) {
+            for (std::uint32_t lanes = batch.active; lanes != 0; lanes &= lanes - 1, ++count) {
+                index[count] = std::countr_zero(lanes);
+                rays[count] = batch.rays[index[count]];
+            }
+        }
+        std::uint32_t scatter(std::uint32_t bits) const {
+            std::uint32_t answer = 0;
+            for (; bits != 0; bits &= bits - 1) answer |= std::uint32_t(1) << index[std::countr_zero(bits)];
+            return answer;
+        }
+    };
 
 private:
     // intersect through the top-level index (scenes that chose no direct form).
@@ -257,9 +372,9 @@ public:
         return found;
     }
 
-    // Whether anything lies in (ray.t_min, ray.t_max).
-    bool occluded(const Ray<Real>& ray) const {
-        if (direct_) return occluded_without_index(ray);
+private:
+    // occluded_one in a scene with an index (no direct form).
+    bool occluded_indexed(const Ray<Real>& ray) const {
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;
         std::optional<RayBoxPrecomputed<Real>> box_ray;
@@ -282,26 +397,7 @@ public:
         return blocked || occluded_by_planes(ray);
     }
 
-    // Whether occluded_each can answer: the scenes whose shadow rays skip every index
-    // (direct_: the top level's spheres, one- or two-leaf meshes and planes tested directly).
-    bool occlusion_batches() const { return direct_; }
-
-    // Several shadow rays in one call (a point's rays to its lights): bit i set where rays[i],
-    // for bit i of `lanes`, is occluded, each answered as occluded answers it. One call per
-    // shading point rather than one per light, so that the integrator's loop over the lights
-    // holds no per-ray call for GCC to weigh against its inlining (whole9: a second call of
-    // occluded had taken it and its insides out of line in every point-lit renderer).
-    // Only for occlusion_batches().
-    std::uint32_t occluded_each(const Ray<Real>* rays, std::uint32_t lanes) const {
-        std::uint32_t blocked = 0;
-        for (; lanes != 0; lanes &= lanes - 1) {
-            const int lane = std::countr_zero(lanes);
-            if (occluded_without_index(rays[lane])) blocked |= std::uint32_t(1) << lane;
-        }
-        return blocked;
-    }
-
-    // Whether intersect_each tests its rays side by side: scenes without an index (direct_)
+    // Whether closest_dense tests its rays side by side: scenes without an index (direct_)
     // whose world-space meshes, if any, are each one leaf, under the packed watertight test,
     // and whose top level holds no mesh. The camera rays of hw1's small scenes (a floor of two
     // triangles under spheres, spheres alone) are such rays. A root of two leaves keeps
@@ -315,29 +411,22 @@ public:
         return false;
     }
 
-    // The closest hits of rays[0, count), each as intersect<Culling> gives it alone: its
+    // The closest hits of rays[0, count) side by side, each as closest_one gives it alone: its
     // ray.t_max lowered to the hit and hits[i] filled, bit i of the answer set, where it hits
-    // (count <= 32). Under intersection_batches() the world meshes' leaves are tested against
-    // several rays at once (TriangleMesh::intersect_leaf_lanes, lane by lane the leaf test's
-    // bits), group after group as intersect takes them, then the direct spheres likewise
-    // (intersect_direct_spheres_lanes), each ray then the planes on its own; in scenes with an
-    // index of more than a leaf or two, the rays traverse it together (intersect_through_index);
-    // elsewhere each ray is intersect's. Every ray's hit is intersect's, to the bit.
+    // (count <= 32). BatchRoute::leaf_lanes: the world meshes' leaves are tested against several
+    // rays at once (TriangleMesh::intersect_leaf_lanes, lane by lane the leaf test's bits),
+    // group after group as closest_one takes them, then the direct spheres likewise
+    // (intersect_direct_spheres_lanes), each ray then the planes on its own.
+    // BatchRoute::index_lanes: the rays traverse the index together (intersect_through_index).
     template <BackfaceCulling Culling>
-    std::uint32_t intersect_each(Ray<Real>* rays, Hit<Real>* hits, int count) const {
+    std::uint32_t closest_dense(BatchRoute way, Ray<Real>* rays, Hit<Real>* hits, int count) const {
         std::uint32_t found = 0;
-        if (!intersection_batches()) {
+        if (way == BatchRoute::index_lanes) {
             if constexpr (Mesh::packed) {
-                if (!direct_ && lanes_through_index()) {
-                    for (int first = 0; first < count; first += index_lanes)
-                        found |= intersect_through_index<Culling>(rays + first, hits + first,
-                                                                  std::min(index_lanes, count - first))
-                                 << first;
-                    return found;
-                }
+                for (int first = 0; first < count; first += index_lanes)
+                    found |= intersect_through_index<Culling>(rays + first, hits + first, std::min(index_lanes, count - first))
+                             << first;
             }
-            for (int i = 0; i < count; ++i)
-                if (intersect<Culling>(rays[i], hits[i])) found |= std::uint32_t(1) << i;
             return found;
         }
         if constexpr (Mesh::packed) {
@@ -397,22 +486,18 @@ public:
         return found;
     }
 
-    // Whether each of rays[0, count) is occluded (bit i for rays[i]; count <= 32), each as
-    // occluded answers it: under intersection_batches() the world meshes' leaves and the
+    // Whether each of rays[0, count) is occluded, side by side (bit i for rays[i]; count <=
+    // 32), each as occluded_one answers it. BatchRoute::leaf_lanes: the world meshes' leaves and the
     // direct spheres with a ray in each lane (the shadow rays of a row's camera hits to one
-    // light), the planes ray by ray; elsewhere occluded itself.
-    std::uint32_t occluded_side_by_side(const Ray<Real>* rays, int count) const {
+    // light), the planes ray by ray. BatchRoute::index_lanes: through the index together
+    // (occluded_through_index).
+    std::uint32_t occluded_dense(BatchRoute way, const Ray<Real>* rays, int count) const {
         std::uint32_t blocked = 0;
-        if (!intersection_batches()) {
+        if (way == BatchRoute::index_lanes) {
             if constexpr (Mesh::packed) {
-                if (!direct_) {
-                    for (int first = 0; first < count; first += index_lanes)
-                        blocked |= occluded_through_index(rays + first, std::min(index_lanes, count - first)) << first;
-                    return blocked;
-                }
+                for (int first = 0; first < count; first += index_lanes)
+                    blocked |= occluded_through_index(rays + first, std::min(index_lanes, count - first)) << first;
             }
-            for (int i = 0; i < count; ++i)
-                if (occluded(rays[i])) blocked |= std::uint32_t(1) << i;
             return blocked;
         }
         if constexpr (Mesh::packed) {
@@ -451,6 +536,7 @@ public:
         return blocked;
     }
 
+public:
     bool occluded_by_planes(const Ray<Real>& ray) const {
         for (const PlaneBlock& block : plane_blocks_) {
             alignas(64) Real t[direct_width];
@@ -782,17 +868,7 @@ private:
         return intersect_planes<Culling>(ray, hit) || found;
     }
 
-    // Whether intersect_each takes an index scene's rays together (intersect_through_index):
-    // where the top level has its index, or a world mesh has a tree to traverse, not only a
-    // root of one or two leaves.
-    bool lanes_through_index() const {
-        if (!direct_top_ && !top_objects_.empty()) return true;
-        for (const WorldMeshes& group : world_meshes_)
-            if (!group.leaves) return true;
-        return false;
-    }
-
-    // intersect_each in a scene traversed through its index (no direct form), for up to
+    // closest_dense in a scene traversed through its index (no direct form), for up to
     // index_lanes rays: each world mesh's closest hits for the rays together
     // (TriangleMesh::intersect_lanes: each ray set up and tested as intersect_indexed sets it up
     // and tests it, the leaves visited in one order for all), then each ray's top level and
@@ -953,7 +1029,7 @@ private:
                                                           t_min, t_max, lanes, hits, tied);
     }
 
-    // occluded_side_by_side in a scene traversed through its index (no direct form), for up to
+    // occluded_dense in a scene traversed through its index (no direct form), for up to
     // index_lanes rays: every level's any hits found for the rays together, each ray set up and
     // tested as occluded sets it up and tests it (WideBvhTree::traverse_any_lanes), so each
     // ray's answer is occluded's. A row's shadow rays to one light reach the same nodes, whose

@@ -241,7 +241,7 @@ private:
     }
 
     bool intersect(Ray<Real>& ray, int depth, Hit<Real>& hit) const {
-        return intersect_culled(geometry_, settings_.backface_culling, depth, ray, hit);
+        return closest_hit(geometry_, ray, hit, culling_at_depth(settings_.backface_culling, depth));
     }
 
     // Mirrors and conductors reflect; dielectrics reflect or refract, chosen by the Fresnel
@@ -310,7 +310,7 @@ private:
                 // An object light's own surface is at the far end: stop short of it.
                 shadow.t_max = glm::length(target - shadow.origin) * (1 - Real(1e-4));
             }
-            if (geometry_.occluded(shadow)) return;
+            if (blocked(geometry_, shadow)) return;
             Vec3<Real> contribution = evaluate_brdf(material, normal, sample.direction, wo) * cos_light * sample.radiance;
             if (params.multiple_importance && sample.pdf > 0)
                 contribution *= path_tracing::power_heuristic(

@@ -9,6 +9,7 @@
 
 #include <prism/geometry/backface_culling.hpp>
 #include <prism/geometry/hit.hpp>
+#include <prism/geometry/ray_batch.hpp>
 #include <prism/light/light_sample.hpp>
 #include <prism/light/light_set.hpp>
 #include <prism/light/point_light.hpp>
@@ -86,17 +87,12 @@ template <class Textures, class Real>
 inline constexpr bool textured = !std::is_same_v<Textures, NoTextures<Real>>;
 
 // The surface point at a hit, with (u, v) and tangents only where textures may read them, and
-// the exact point with its error bound only where rays leave by it (RayOffset::error_bound). An
-// index from outside (accel/embree.hpp) fills everything.
+// the exact point with its error bound only where rays leave by it (RayOffset::error_bound).
 // Inlined into trace, so that surface<false> is (SceneGeometry::surface).
 template <bool Textured, Scalar Real, class Geometry>
 [[gnu::always_inline]] inline SurfacePoint<Real> shading_surface(const Geometry& geometry, const Ray<Real>& ray, const Hit<Real>& hit,
                                    RayOffset offset) {
-    const bool spawn_point = offset == RayOffset::error_bound;
-    if constexpr (requires { geometry.template surface<Textured>(ray, hit, spawn_point); })
-        return geometry.template surface<Textured>(ray, hit, spawn_point);
-    else
-        return geometry.surface(ray, hit);
+    return geometry.template surface<Textured>(ray, hit, offset == RayOffset::error_bound);
 }
 
 // The same for an integrator's texture set: a renderer compiled with textures parametrises its
@@ -167,33 +163,13 @@ public:
     // Radiance arriving along a camera ray with a unit direction.
     Vec3<Real> radiance(const Ray<Real>& ray, CameraPath& path) const { return trace(ray, 0, path, Real(0)); }
 
-    // Camera rays several at a time, under prism's own geometry (SceneGeometry): first their
-    // closest hits (camera_hits, the hits radiance's own intersection finds, each ray's t_max
-    // lowered as it lowers it; side by side where SceneGeometry::intersection_batches, else one
-    // by one), then each ray's radiance from its hit (radiance_at), the rest of radiance's
-    // work. Index scenes gain from the rows too: their shadow rays go side by side through
-    // the index (hw2 horse_instanced: 0.96 of the CPU time with rows, before that).
-    bool batches_camera_rays(const scene::Camera&) const {
-        if constexpr (requires { geometry_.intersection_batches(); }) return true;
-        else return false;
-    }
-    // Under another geometry (an outside index: accel/embree.hpp), which batches nothing, the
-    // rays are intersected one by one.
+    // Camera rays several at a time: first their closest hits, as one batch through the query
+    // seam (camera_hits: the hits radiance's own intersection finds, each ray's t_max lowered as
+    // it lowers it), then each ray's radiance from its hit (radiance_at), the rest of
+    // radiance's work. The index decides how side by side the hits are found.
+    bool batches_camera_rays(const scene::Camera&) const { return true; }
     std::uint32_t camera_hits(Ray<Real>* rays, Hit<Real>* hits, int count) const {
-        if constexpr (!requires { geometry_.template intersect_each<BackfaceCulling::none>(rays, hits, count); }) {
-            std::uint32_t found = 0;
-            for (int i = 0; i < count; ++i)
-                if (intersect_culled(geometry_, settings_.backface_culling, 0, rays[i], hits[i])) found |= std::uint32_t(1) << i;
-            return found;
-        } else {
-            switch (settings_.backface_culling) {
-                case BackfaceCulling::none: break;
-                case BackfaceCulling::triangles:
-                    return geometry_.template intersect_each<BackfaceCulling::triangles>(rays, hits, count);
-                case BackfaceCulling::all: return geometry_.template intersect_each<BackfaceCulling::all>(rays, hits, count);
-            }
-            return geometry_.template intersect_each<BackfaceCulling::none>(rays, hits, count);
-        }
+        return geometry_.intersect(RayBatch<Real>::all(rays, count, settings_.backface_culling), hits);
     }
     Vec3<Real> radiance_at(const Ray<Real>& ray, const Hit<Real>& hit, bool found, CameraPath& path) const {
         if (!found) return escaped(ray.direction, 0, path.pixel_uv);
@@ -202,17 +178,14 @@ public:
 
     // radiance_at for a row's camera rays together (count <= row_width), in point-lit
     // renderers without textures: every hit's shadow rays are made first, then each light's
-    // are tested side by side across the row (SceneGeometry::occluded_side_by_side: a ray in
-    // each SIMD lane), then each point is shaded; the mirrors' and conductors' reflected rays
-    // then go on as a row of their own (shade_row). The same draws, rays, tests and sums as
-    // radiance_at, so the same bits. `make_path(i)`: ray i's CameraPath (its pixel's stream,
-    // by reference).
-    // Other renderers (textures, other lights, an outside index) take the rays one by one.
+    // are tested across the row as one batch, then each point is shaded; the mirrors' and
+    // conductors' reflected rays then go on as a row of their own (shade_row). The same draws,
+    // rays, tests and sums as radiance_at, so the same bits. `make_path(i)`: ray i's
+    // CameraPath (its pixel's stream, by reference).
+    // Other renderers (textures, other lights) take the rays one by one.
     static constexpr int row_width = 16;
     static constexpr std::size_t row_lights = 8;
-    static constexpr bool shades_rows =
-        !textured<Textures, Real> && std::is_same_v<LightSetT, LightSet<Real, PointLight>> &&
-        requires(const Geometry& geometry, const Ray<Real>* rays) { geometry.occluded_side_by_side(rays, 1); };
+    static constexpr bool shades_rows = !textured<Textures, Real> && std::is_same_v<LightSetT, LightSet<Real, PointLight>>;
     template <class MakePath>
     void radiance_row(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count, MakePath make_path,
                       Vec3<Real>* radiance) const {
@@ -237,8 +210,8 @@ public:
     // draws depend on every earlier sample's, but the lights that draw nothing (point,
     // directional, spot: `sample(at)` alone) need no draw to be sampled: their shadow rays from
     // the samples' camera hits are made first, up to prelit_lights such lights, and tested
-    // side by side light by light (SceneGeometry::occluded_side_by_side: the samples of a
-    // pixel meet nearly one point, so their rays reach the same nodes). Then each sample is
+    // light by light as one batch each (the samples of a pixel meet nearly one point, so their
+    // rays reach the same nodes: the index takes them side by side). Then each sample is
     // shaded as shade shades it, its stream stepping past those lights' draws in their turn.
     // The same rays, tests, draws and sums as radiance_at, so the same bits. Only where
     // prelights(): the scene has such a light.
@@ -246,20 +219,8 @@ public:
     static_assert(prelit_width == row_width, "radiances_at makes point lights' rays as rows do (light_lanes)");
     static constexpr std::size_t prelit_lights = 8;
     bool prelights() const { return prelit_count_ > 0; }
-    // Under an outside index, which has no side-by-side shadow rays, the samples one by one.
     void radiances_at(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count, CameraPath& path,
-                      Vec3<Real>* radiance) const {
-        if constexpr (requires(const Ray<Real>* shadows) { geometry_.occluded_side_by_side(shadows, 1); })
-            prelit_radiances(rays, hits, found, count, path, radiance);
-        else
-            for (int i = 0; i < count; ++i) radiance[i] = radiance_at(rays[i], hits[i], (found >> i) & 1, path);
-    }
-
-private:
-    // radiances_at under prism's own geometry.
-    void prelit_radiances(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count, CameraPath& path,
-                          Vec3<Real>* radiance) const
-        requires requires(const Geometry& geometry, const Ray<Real>* shadows) { geometry.occluded_side_by_side(shadows, 1); }
+                      Vec3<Real>* radiance) const
     {
         // shade's state at a camera hit up to its direct lighting (the point made in place).
         struct PrelitPoint {
@@ -354,7 +315,7 @@ private:
                     }
                 }
                 if (n == 0) return;
-                const std::uint32_t blocked = geometry_.occluded_side_by_side(shadows.data(), n);
+                const std::uint32_t blocked = geometry_.occluded(RayBatch<Real>::all(shadows.data(), n));
                 for (int m = 0; m < n; ++m)
                     if (!((blocked >> m) & 1)) points[std::size_t(owner[std::size_t(m)])].visible |= std::uint32_t(1) << j;
             }
@@ -485,11 +446,11 @@ private:
                 owner[std::size_t(n++)] = i;
             }
             if (n == 0) continue;
-            for (std::uint32_t hit = geometry_.occluded_side_by_side(packed.data(), n); hit != 0; hit &= hit - 1)
+            for (std::uint32_t hit = geometry_.occluded(RayBatch<Real>::all(packed.data(), n)); hit != 0; hit &= hit - 1)
                 blocked[std::size_t(owner[std::size_t(std::countr_zero(hit))])] |= std::uint32_t(1) << k;
         }
         // Mirrors' and conductors' reflected rays, traced after the row's shading with their
-        // closest hits found side by side (intersect_each, as trace's own intersection finds
+        // closest hits found as one batch (as trace's own intersection finds
         // them below depth 0) and shaded as a row again, down to row_depth; each pixel draws
         // from its own stream, so its draws keep their order.
         Unconstructed<Ray<Real>, row_width> reflections;
@@ -535,8 +496,7 @@ private:
         }
         if (reflected_count == 0) return;
         std::array<Hit<Real>, row_width> reflection_hits;
-        const std::uint32_t met =
-            geometry_.template intersect_each<BackfaceCulling::none>(reflections.data(), reflection_hits.data(), reflected_count);
+        const std::uint32_t met = geometry_.intersect(RayBatch<Real>::all(reflections.data(), reflected_count), reflection_hits.data());
         std::array<Vec3<Real>, row_width> traced;
         if (depth + 1 < row_depth) {
             shade_row<false>(reflections.data(), reflection_hits.data(), met, reflected_count, reflection_paths.data(),
@@ -758,7 +718,7 @@ private:
     }
 
     bool intersect(Ray<Real>& ray, int depth, Hit<Real>& hit) const {
-        return intersect_culled(geometry_, settings_.backface_culling, depth, ray, hit);
+        return closest_hit(geometry_, ray, hit, culling_at_depth(settings_.backface_culling, depth));
     }
 
     // A ray that meets nothing: primary rays show the background (texture, environment or
@@ -778,15 +738,13 @@ private:
     // for bit. Inlined for stored_whole, as leaving_ray is.
     [[gnu::always_inline]] Ray<Real> leaving(const SurfacePoint<Real>& point, const Vec3<Real>& normal,
                                              const Vec3<Real>& direction, Real time, SpawnOrigins& origins) const {
-        if constexpr (requires { geometry_.spawn_side(point, direction); }) {
-            if (settings_.ray_offset == RayOffset::error_bound) {
-                const int side = geometry_.spawn_side(point, direction);
-                if (!(origins.known & (1u << side))) {
-                    origins.origin[std::size_t(side)] = geometry_.spawn_origin(point, direction);
-                    origins.known |= 1u << side;
-                }
-                return Ray<Real>{origins.origin[std::size_t(side)], direction, Real(0), infinity<Real>, time};
+        if (settings_.ray_offset == RayOffset::error_bound) {
+            const int side = geometry_.spawn_side(point, direction);
+            if (!(origins.known & (1u << side))) {
+                origins.origin[std::size_t(side)] = geometry_.spawn_origin(point, direction);
+                origins.known |= 1u << side;
             }
+            return Ray<Real>{origins.origin[std::size_t(side)], direction, Real(0), infinity<Real>, time};
         }
         return leaving_ray(geometry_, settings_.ray_offset, epsilon_, point, normal, direction, time);
     }
@@ -795,9 +753,9 @@ private:
     // the reflected and refracted rays.
     Vec3<Real> direct_lighting(const SurfacePoint<Real>& point, const Vec3<Real>& normal, const Vec3<Real>& to_viewer,
                                const Material<Real>& material, Random& random, SpawnOrigins& origins) const {
-        if constexpr (std::is_same_v<LightSetT, LightSet<Real, PointLight>> && requires { geometry_.occluded_each(nullptr, 0u); }) {
+        if constexpr (std::is_same_v<LightSetT, LightSet<Real, PointLight>>) {
             const std::vector<PointLight<Real>>& lights = *lights_.template of_type<PointLight>();
-            if (lights.size() > 1 && geometry_.occlusion_batches())
+            if (lights.size() > 1)
                 return point_lighting_batched(point, normal, to_viewer, material, random, origins, lights);
         }
         Vec3<Real> color(0);
@@ -839,12 +797,12 @@ private:
         // rounding). Area lights are no geometry, so their rule above stays.
         if constexpr (L::kind == scene::LightKind::object)
             shadow.t_max = glm::length(position + sample.direction * sample.distance - shadow.origin) * (1 - Real(1e-4));
-        if (geometry_.occluded(shadow)) return;
+        if (blocked(geometry_, shadow)) return;
         color += reflected(material, normal, to_viewer, sample, cos_light);
     }
 
     // Several point lights' shadow rays made before the first is tested, and tested in one
-    // call (SceneGeometry::occluded_each), up to eight at a time; then the lit ones shaded in
+    // batch (the query seam), up to eight at a time; then the lit ones shaded in
     // the lights' order. The chains of square roots and divisions that aim each ray (the
     // light's sample, the aim from the offset origin) overlap instead of each waiting for the
     // previous light's test. The same draws (the stream only steps past two numbers a light),
@@ -866,7 +824,7 @@ private:
             // simple_reflectance's samples of this function).
             std::array<Vec3<Real>, batch> directions, radiances;
             std::array<Real, batch> cosines;
-            // Made for the lit lanes alone, the ones occluded_each reads (memory/unconstructed.hpp).
+            // Made for the lit lanes alone, the batch's active ones (memory/unconstructed.hpp).
             Unconstructed<Ray<Real>, batch> shadows;
             std::uint32_t lit = 0;
             for (std::size_t i = 0; i < count; ++i) {
@@ -879,7 +837,7 @@ private:
                 make_shadow_ray(shadows.make(i), point, normal, sample, origins);
                 lit |= std::uint32_t(1) << i;
             }
-            lit &= ~geometry_.occluded_each(shadows.data(), lit);
+            lit &= ~geometry_.occluded(RayBatch<Real>{shadows.data(), int(count), lit});
             for (; lit != 0; lit &= lit - 1) {
                 const std::size_t i = std::size_t(std::countr_zero(lit));
                 LightSample<Real> sample;
