@@ -1,9 +1,8 @@
 // Embree 3 as an acceleration policy: `Config<float, Embree, ...>` renders any scene with Embree
-// finding the hits and prism doing everything else. Embree replaces the traversal, not the
-// shading: the scene's shapes, transforms, textures and surface() stay in a SceneGeometry
-// (under BruteForce, whose index is only the identity order and is never traversed), and
-// Embree's scene mirrors its objects, with Embree's geometry IDs equal to prism's object
-// indices. Embree says which triangle of which object is hit first; prism's own test on that
+// finding the hits and prism doing everything else. Embree replaces prism's index (SceneIndex),
+// not the surfaces: EmbreeGeometry is prism's SceneSurfaces (built once, meshes in the file's
+// triangle order, the order Embree names them in) with Embree's scene beside it, which mirrors
+// the objects, Embree's geometry IDs equal to prism's object numbers (place_objects). Embree says which triangle of which object is hit first; prism's own test on that
 // one triangle then computes t and the barycentrics, so a hit is shaded from exactly the
 // numbers prism's own accelerator would give for it; where prism's test declines (an edge
 // Embree's float test takes and the watertight test gives to the neighbour) Embree's own
@@ -14,8 +13,10 @@
 #pragma once
 
 #include <prism/accel/accelerator.hpp>
+#include <prism/geometry/planes.hpp>
 #include <prism/geometry/ray_batch.hpp>
-#include <prism/geometry/scene_geometry.hpp>
+#include <prism/geometry/scene_surfaces.hpp>
+#include <prism/geometry/triangle_mesh.hpp>
 
 #include <embree3/rtcore.h>
 #include <glm/gtc/matrix_transform.hpp>
@@ -72,12 +73,18 @@ struct Embree {
 // horse_instanced came back occluded). So in double every triangle Embree's test accepts is
 // tested again by prism's double test in a filter callback, and only prism's yes counts.
 template <Scalar Real, bool MotionBlur = false>
-class EmbreeGeometry {
+class EmbreeGeometry : public SceneSurfaces<Real, Watertight, MotionBlur> {
 public:
-    using Shapes = SceneGeometry<Real, BruteForce<Watertight>, MotionBlur>;
+    using Surfaces = SceneSurfaces<Real, Watertight, MotionBlur>;
 
     explicit EmbreeGeometry(const scene::Scene& scene, unsigned threads = 0)
-        : shapes_(scene), device_(make_device(threads)), scene_(rtcNewScene(device_.get())) {
+        : Surfaces(scene,
+                   place_objects<Real>(
+                       scene, [&](std::size_t m) { return TriangleMesh<Real, BruteForce<Watertight>>::bounds_of(scene.meshes[m]); },
+                       MotionBlur),
+                   [](std::size_t) { return std::span<const std::uint32_t>(); }),
+          planes_(scene, std::uint32_t(scene.meshes.size() + scene.mesh_instances.size() + scene.spheres.size())),
+          device_(make_device(threads)), scene_(rtcNewScene(device_.get())) {
         std::vector<std::uint32_t> object_of_mesh(scene.meshes.size());
         std::uint32_t object = 0;
         for (std::size_t m = 0; m < scene.meshes.size(); ++m)
@@ -86,16 +93,12 @@ public:
             add_mesh_object(scene, instance.base_mesh, instance.transform, instance.motion, object++);
         user_data_.reserve(scene.spheres.size());
         for (std::size_t s = 0; s < scene.spheres.size(); ++s) add_sphere_object(object++);
-        if (object != shapes_.instance_count())
-            throw std::logic_error("EmbreeGeometry: objects out of step with SceneGeometry");
+        if (object != this->instance_count())
+            throw std::logic_error("EmbreeGeometry: objects out of step with the surfaces");
         rtcSetSceneFlags(scene_.get(), RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
         rtcCommitScene(scene_.get());
         check("committing the scene");
     }
-
-    std::size_t instance_count() const { return shapes_.instance_count(); }
-    std::size_t triangle_count() const { return shapes_.triangle_count(); }
-    Aabb<Real> bounds() const { return shapes_.bounds(); }
 
     // The query seam's two entries (geometry/ray_batch.hpp), each active ray queried on its own:
     // Embree's single-ray queries, with prism's own test on the primitive Embree finds.
@@ -124,19 +127,6 @@ public:
         return blocked;
     }
 
-    // What a hit means is prism's own (SceneGeometry's surfaces).
-    template <bool Parametrised = true>
-    SurfacePoint<Real> surface(const Ray<Real>& ray, const Hit<Real>& hit, bool spawn_point = true) const {
-        return shapes_.template surface<Parametrised>(ray, hit, spawn_point);
-    }
-    Vec3<Real> emitted(std::uint32_t object) const { return shapes_.emitted(object); }
-    Vec3<Real> spawn_origin(const SurfacePoint<Real>& point, const Vec3<Real>& direction) const {
-        return shapes_.spawn_origin(point, direction);
-    }
-    int spawn_side(const SurfacePoint<Real>& point, const Vec3<Real>& direction) const {
-        return shapes_.spawn_side(point, direction);
-    }
-
     // Bytes Embree holds for this scene (its BVHs and copies of the triangles), as its memory
     // monitor counted them during the build.
     std::int64_t embree_bytes() const { return device_.bytes(); }
@@ -158,13 +148,13 @@ private:
                 ray_hit.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? ray_hit.hit.instID[0] : ray_hit.hit.geomID;
             // prism's test on Embree's primitive (in double the filter already accepted it).
             Ray<Real> probe = ray;
-            if (!shapes_.intersect_primitive(object, ray_hit.hit.primID, probe, hit))
+            if (!this->intersect_primitive(object, ray_hit.hit.primID, probe, hit))
                 hit = Hit<Real>{Real(ray_hit.ray.tfar), object, ray_hit.hit.primID, Real(ray_hit.hit.u),
                                 Real(ray_hit.hit.v)};
             ray.t_max = hit.t;
             found = true;
         }
-        return shapes_.template intersect_planes<Culling>(ray, hit) || found;
+        return planes_.template closest<Culling>(ray, hit) || found;
     }
 
     // Whether anything lies in (ray.t_min, ray.t_max): open at t_max, like prism's own.
@@ -178,7 +168,7 @@ private:
         Context context(this, ray);
         context.base.filter = filter_for<BackfaceCulling::none, true>();
         rtcOccluded1(scene_.get(), &context.base, &embree);
-        return embree.tfar == -std::numeric_limits<float>::infinity() || shapes_.occluded_by_planes(ray);
+        return embree.tfar == -std::numeric_limits<float>::infinity() || planes_.occludes(ray);
     }
 
     // Embree's handles, released in order (scene before device).
@@ -320,7 +310,7 @@ private:
 
     static void sphere_bounds(const RTCBoundsFunctionArguments* args) {
         const auto* data = static_cast<const SphereUserData*>(args->geometryUserPtr);
-        const Aabb<Real> box = data->self->shapes_.world_bounds(data->object);
+        const Aabb<Real> box = data->self->placement(data->object).world_bounds;
         // Rounded outwards to float, so the box still holds the sphere.
         args->bounds_o->lower_x = next_down(float(box.min.x));
         args->bounds_o->lower_y = next_down(float(box.min.y));
@@ -338,7 +328,7 @@ private:
         // could lie inside the sphere a ray just left); Embree keeps the closest so far.
         Ray<Real> ray = *reinterpret_cast<const Context*>(args->context)->world_ray;
         Hit<Real> hit;
-        if (!data->self->shapes_.intersect_primitive(data->object, 0, ray, hit)) return;
+        if (!data->self->intersect_primitive(data->object, 0, ray, hit)) return;
         if (!(float(hit.t) <= RTCRayN_tfar(rays, args->N, 0))) return;
         RTCRayN_tfar(rays, args->N, 0) = float(hit.t);
         RTCHitN* embree_hit = RTCRayHitN_HitN(args->rayhit, args->N);
@@ -355,7 +345,7 @@ private:
         Ray<Real> ray = *reinterpret_cast<const Context*>(args->context)->world_ray;
         const Real t_max = ray.t_max;
         Hit<Real> hit;
-        if (data->self->shapes_.intersect_primitive(data->object, 0, ray, hit) && hit.t < t_max)
+        if (data->self->intersect_primitive(data->object, 0, ray, hit) && hit.t < t_max)
             RTCRayN_tfar(args->ray, args->N, 0) = -std::numeric_limits<float>::infinity();
     }
 
@@ -381,7 +371,7 @@ private:
             // prism's own orientation test, on prism's triangle and ray: with Embree's rounded
             // normal and ray, grazing triangles (hw1 rt_raven's) came out on the other side
             // (81.8 -> 72.7 dB).
-            if (context->self->shapes_.culled(object, primitive, *context->world_ray, Culling)) {
+            if (context->self->culled(object, primitive, *context->world_ray, Culling)) {
                 args->valid[0] = 0;
                 return;
             }
@@ -390,12 +380,12 @@ private:
             Ray<Real> ray = *context->world_ray;
             const Real t_max = ray.t_max;
             Hit<Real> hit;
-            const bool hit_by_prism = context->self->shapes_.intersect_primitive(object, primitive, ray, hit);
+            const bool hit_by_prism = context->self->intersect_primitive(object, primitive, ray, hit);
             if (!hit_by_prism || (AnyHit && !(hit.t < t_max))) args->valid[0] = 0;
         }
     }
 
-    Shapes shapes_;
+    PlaneSet<Real> planes_;
     DeviceHandle device_;
     SceneHandle scene_;
     std::vector<std::unique_ptr<SceneHandle>> mesh_scenes_;

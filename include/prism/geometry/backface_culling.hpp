@@ -42,4 +42,7 @@ enum class BackfaceCulling {
     all,        // camera rays skip every back-facing triangle and plane
 };
 
+// The rule for a mesh's triangles, whatever their shading: both rules that cull skip them.
+constexpr bool culls_back_faces(BackfaceCulling culling) { return culling != BackfaceCulling::none; }
+
 }  // namespace prism

@@ -1,8 +1,9 @@
-// A triangle mesh in its object space with its own spatial index: the bottom level of the
-// two-level hierarchy, shared by every instance of the mesh. Triangles are stored as a vertex
-// soup in index order, so a leaf reads contiguous memory; shading data stays indexed.
-// SceneGeometry also builds one over several meshes in world space (one index for all their
-// triangles), whose parts then keep only their shading data (ShadingOnly).
+// The index over a triangle mesh in its object space: the bottom level of the two-level
+// hierarchy, shared by every object that places the mesh. Triangles are stored as a vertex soup
+// in index order (or as packets of the wide BVH's leaves), so a leaf reads contiguous memory.
+// SceneIndex also builds one over several meshes in world space (one index for all their
+// triangles). What a hit means (normals, texture coordinates) is MeshSurface's
+// (geometry/mesh_surface.hpp), which keeps the triangles in the same slot order.
 #pragma once
 
 #include <prism/accel/accelerator.hpp>
@@ -37,45 +38,25 @@ public:
     using Packets = typename TrianglePacketsOf<Policy, Real>::type;
     static constexpr bool packed = !std::is_same_v<Packets, NoTrianglePackets>;
 
-    explicit TriangleMesh(const scene::Mesh& mesh)
-        : smooth_(mesh.shading == scene::ShadingMode::smooth), triangle_count_(mesh.triangles.size()) {
+    explicit TriangleMesh(const scene::Mesh& mesh) {
         const scene::Mesh* const parts[] = {&mesh};
-        build_index(parts);
-        const auto& order = index_.primitive_indices();
-        faces_.reserve(order.size());
-        for (const std::uint32_t i : order) faces_.push_back(mesh.triangles[i]);
-        keep_shading_data(mesh);
-    }
-
-    // A mesh whose triangles another index tests (SceneGeometry's world-space meshes, merged
-    // into one index): it keeps only what surface() and spawn_point() read, its triangles in
-    // the file's order, so a slot here is the triangle's index in scene::Mesh::triangles.
-    struct ShadingOnly {};
-    TriangleMesh(const scene::Mesh& mesh, ShadingOnly)
-        : smooth_(mesh.shading == scene::ShadingMode::smooth), triangle_count_(mesh.triangles.size()) {
-        triangles_.reserve(mesh.triangles.size());
-        faces_ = mesh.triangles;
-        for (const auto& face : mesh.triangles) {
-            triangles_.push_back({Vec3<Storage>(mesh.positions[face[0]]), Vec3<Storage>(mesh.positions[face[1]]),
-                                  Vec3<Storage>(mesh.positions[face[2]])});
-            bounds_.extend(triangle_box(mesh, face));
-        }
-        keep_shading_data(mesh);
+        build(parts);
     }
 
     // One index over the triangles of several meshes that share a space, numbered part after
-    // part (part 0's triangles first): for traversal only. A hit's slot names its triangle
-    // through source_triangle; shading stays with each part's own (ShadingOnly) mesh, so
-    // surface(), spawn_point() and the single-triangle tests are not for this mesh.
-    explicit TriangleMesh(std::span<const scene::Mesh* const> parts) {
-        for (const scene::Mesh* part : parts) triangle_count_ += part->triangles.size();
-        build_index(parts);
-        // The packets hold the leaves' triangles: the plain copy would be read by nothing.
-        if constexpr (packed) {
-            triangles_.clear();
-            triangles_.shrink_to_fit();
-        }
+    // part (part 0's triangles first). A hit's slot names its triangle through source_triangle.
+    explicit TriangleMesh(std::span<const scene::Mesh* const> parts) { build(parts); }
+
+    // The box of a mesh's triangles, as an index over them would bound them (each triangle's
+    // box widened where Storage is wider than Real), without building the index.
+    static Aabb<Real> bounds_of(const scene::Mesh& mesh) {
+        Aabb<Real> box;
+        for (const auto& face : mesh.triangles) box.extend(triangle_box(mesh, face));
+        return box;
     }
+
+    // The slots' triangles as the file numbers them: what MeshSurface keeps in the same order.
+    std::span<const std::uint32_t> slot_order() const { return index_.primitive_indices(); }
 
     // The triangle in `slot`, numbered as the meshes it was built from list them (part after
     // part for several meshes).
@@ -88,8 +69,7 @@ public:
 
     Aabb<Real> bounds() const { return bounds_; }
     std::size_t triangle_count() const { return triangle_count_; }
-    bool smooth() const { return smooth_; }  // shadingMode="smooth": normals interpolated from the vertices
-    // What traversal reads: the index and the triangles its leaves test (not the shading data).
+    // What traversal reads: the index and the triangles its leaves test.
     std::size_t accelerator_bytes() const {
         std::size_t bytes = index_.memory_bytes() + triangles_.capacity() * sizeof(triangles_[0]);
         if constexpr (packed) bytes += packets_.memory_bytes();
@@ -236,26 +216,6 @@ public:
         return found;
     }
 
-    // Whether culling skips the triangle in `slot` for a ray of this direction (object space):
-    // the test intersect<true> makes.
-    bool faces_away(std::uint32_t slot, const Vec3<Real>& direction) const {
-        const auto& p = triangles_[slot];
-        return glm::dot(Vec3<Real>(glm::cross(p[1] - p[0], p[2] - p[0])), direction) > 0;
-    }
-
-    // The triangle in `slot` alone, with the same test and the same hit record as intersect.
-    bool intersect_triangle(std::uint32_t slot, const Ray<Real>& ray, Real& t_max, Hit<Real>& hit) const {
-        const auto& p = triangles_[slot];
-        TriangleHit<Real> triangle_hit;
-        if (!Intersector::intersect(Prepared(ray), p[0], p[1], p[2], ray.t_min, t_max, triangle_hit)) return false;
-        t_max = triangle_hit.t;
-        hit.t = triangle_hit.t;
-        hit.primitive = slot;
-        hit.b1 = triangle_hit.b1;
-        hit.b2 = triangle_hit.b2;
-        return true;
-    }
-
     bool occluded(const Ray<Real>& ray, Real t_max) const {
         return occluded(ray, TraversalRay(ray), TriangleRay(ray), t_max);
     }
@@ -332,43 +292,17 @@ public:
                                          });
     }
 
-    // Object-space normals and texture coordinates at a hit.
-    // The hit point computed from the barycentrics, with the error bound a leaving ray must
-    // clear (geometry/surface_error.hpp), in object space and the precision the triangle is
-    // stored in.
-    [[gnu::always_inline]] PointWithError<Real> spawn_point(const Hit<Real>& hit) const {
-        const auto& p = triangles_[hit.primitive];
-        return triangle_spawn_point<Real>(p[0], p[1], p[2], hit.b1, hit.b2);
-    }
-
-    // Normals, texture coordinates and the (u, v) tangent frame at a hit, in object space.
-    void surface(const Hit<Real>& hit, Vec3<Real>& geometric_normal, Vec3<Real>& shading_normal, Vec2<Real>& uv,
-                 Vec3<Real>& dpdu, Vec3<Real>& dpdv) const {
-        const auto& p = triangles_[hit.primitive];
-        geometric_normal = glm::normalize(Vec3<Real>(glm::cross(p[1] - p[0], p[2] - p[0])));
-        const Real b0 = Real(1) - hit.b1 - hit.b2;
-        const auto& face = faces_[hit.primitive];
-        shading_normal = geometric_normal;
-        if (smooth_) {
-            const Vec3<Real> n = b0 * vertex_normals_[face[0]] + hit.b1 * vertex_normals_[face[1]] +
-                                 hit.b2 * vertex_normals_[face[2]];
-            const Real length = glm::length(n);
-            if (length > 0) shading_normal = n / length;
-        }
-        if (uvs_.empty()) return;
-        const Vec2<Real> uv0 = uvs_[face[0]], uv1 = uvs_[face[1]], uv2 = uvs_[face[2]];
-        uv = b0 * uv0 + hit.b1 * uv1 + hit.b2 * uv2;
-        // Solve [e1 e2] = [dpdu dpdv] [duv1 duv2] for the tangents (pbrt-v4 6.5.3); a
-        // degenerate (u, v) mapping leaves them zero and the textures then keep the normal.
-        const Vec2<Real> duv1 = uv1 - uv0, duv2 = uv2 - uv0;
-        const Real determinant = duv1.x * duv2.y - duv1.y * duv2.x;
-        if (std::abs(determinant) < std::numeric_limits<Real>::min()) return;
-        const Vec3<Real> e1 = Vec3<Real>(p[1] - p[0]), e2 = Vec3<Real>(p[2] - p[0]);
-        dpdu = (duv2.y * e1 - duv1.y * e2) / determinant;
-        dpdv = (duv1.x * e2 - duv2.x * e1) / determinant;
-    }
-
 private:
+    void build(std::span<const scene::Mesh* const> parts) {
+        for (const scene::Mesh* part : parts) triangle_count_ += part->triangles.size();
+        build_index(parts);
+        // The packets hold the leaves' triangles: the plain copy would be read by nothing.
+        if constexpr (packed) {
+            triangles_.clear();
+            triangles_.shrink_to_fit();
+        }
+    }
+
     // The index over the parts' triangles (their boxes widened where Storage is wider than
     // Real), and the triangles copied into its slots, with their packets.
     void build_index(std::span<const scene::Mesh* const> parts) {
@@ -434,46 +368,12 @@ private:
         return box;
     }
 
-    void keep_shading_data(const scene::Mesh& mesh) {
-        if (smooth_) vertex_normals_ = smooth_normals(mesh);
-        if (!mesh.uvs.empty())
-            for (const auto& uv : mesh.uvs) uvs_.emplace_back(uv);
-    }
-
-    // Vertex normals as the course's renderer computes them: the normalised sum of the faces'
-    // unnormalised normals, i.e. weighted by face area (with unit face normals instead,
-    // low_poly_smooth drops from 58 to 30 dB against the course's image). A PLY file's own
-    // normals take precedence.
-    static std::vector<Vec3<Real>> smooth_normals(const scene::Mesh& mesh) {
-        std::vector<Vec3<Real>> result(mesh.positions.size(), Vec3<Real>(0));
-        if (mesh.normals.size() == mesh.positions.size()) {
-            for (std::size_t i = 0; i < mesh.normals.size(); ++i) result[i] = Vec3<Real>(glm::normalize(mesh.normals[i]));
-            return result;
-        }
-        std::vector<glm::dvec3> sums(mesh.positions.size(), glm::dvec3(0.0));
-        for (const auto& face : mesh.triangles) {
-            const glm::dvec3 area_weighted = glm::cross(mesh.positions[face[1]] - mesh.positions[face[0]],
-                                                        mesh.positions[face[2]] - mesh.positions[face[0]]);
-            for (std::uint32_t v : face) sums[v] += area_weighted;
-        }
-        for (std::size_t i = 0; i < sums.size(); ++i) {
-            const double length = glm::length(sums[i]);
-            if (length > 0) result[i] = Vec3<Real>(sums[i] / length);
-        }
-        return result;
-    }
-
-    bool smooth_ = false;
     std::size_t triangle_count_ = 0;
     Aabb<Real> bounds_;
     Index index_;
     [[no_unique_address]] Packets packets_;
-    // In slot order: the index's order, or the file's for a ShadingOnly mesh. A mesh over
-    // several parts keeps no faces, and no triangles where its packets hold them.
+    // In slot order, for the leaf tests; none where the packets hold the triangles.
     HugePageVector<std::array<Vec3<Storage>, 3>> triangles_;
-    std::vector<std::array<std::uint32_t, 3>> faces_;  // vertex indices
-    std::vector<Vec3<Real>> vertex_normals_;
-    std::vector<Vec2<Real>> uvs_;
 };
 
 }  // namespace prism

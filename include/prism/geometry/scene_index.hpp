@@ -1,0 +1,619 @@
+// What finds the hits of a scene, in the renderer's precision: the meshes' own indices (built
+// once per mesh; a MeshInstance costs one placement, never a copy of its mesh or its index),
+// spheres and planes, under a top-level index over the objects. This is the two-level
+// hierarchy. The meshes already in world space (no transformation, not moving, not instanced)
+// share one index over all their triangles instead, traversed beside the top level. A top level
+// of a few objects is tested without its index (geometry/direct_top_level.hpp).
+// The query seam's two entries (geometry/ray_batch.hpp) are its only way in: intersect for
+// closest hits, occluded for any hits, each over a batch of rays. Batches side by side are
+// geometry/scene_index_lanes.hpp. What a hit means is SceneSurfaces'; SceneGeometry pairs the two.
+#pragma once
+
+#include <prism/accel/accelerator.hpp>
+#include <prism/geometry/backface_culling.hpp>
+#include <prism/geometry/direct_top_level.hpp>
+#include <prism/geometry/hit.hpp>
+#include <prism/geometry/placement.hpp>
+#include <prism/geometry/planes.hpp>
+#include <prism/geometry/ray_batch.hpp>
+#include <prism/geometry/sphere.hpp>
+#include <prism/geometry/triangle_mesh.hpp>
+#include <prism/memory/unconstructed.hpp>
+#include <prism/scene/scene.hpp>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <type_traits>
+#include <vector>
+
+namespace prism {
+
+template <Scalar Real, class Policy, bool MotionBlur = false>
+    requires AccelerationPolicy<Policy, Real>
+class SceneIndex {
+public:
+    using Index = typename Policy::template Index<Real>;
+    using Mesh = TriangleMesh<Real, Policy>;
+
+    explicit SceneIndex(const scene::Scene& scene)
+        : planes_(scene, std::uint32_t(scene.meshes.size() + scene.mesh_instances.size() + scene.spheres.size())) {
+        const std::vector<bool> merged = merged_meshes(scene);
+        // A single merged mesh needs no merged index: it keeps its own, read without the
+        // translation a merged index's hits need (a cache miss per hit ray on the 766k-triangle
+        // dragon: 5-9% of its camera rays' time).
+        const bool alone = std::count(merged.begin(), merged.end(), true) == 1;
+        meshes_.reserve(scene.meshes.size());
+        for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
+            if (merged[m] && !alone) meshes_.emplace_back(std::nullopt);
+            else meshes_.emplace_back(std::in_place, scene.meshes[m]);
+        }
+        placements_ = place_objects<Real>(
+            scene, [&](std::size_t m) { return meshes_[m] ? meshes_[m]->bounds() : Mesh::bounds_of(scene.meshes[m]); },
+            MotionBlur);
+        for (const auto& sphere : scene.spheres) spheres_.push_back({Vec3<Real>(sphere.center), Real(sphere.radius)});
+        // One index over the merged meshes, flat and smooth alike (they are culled alike), the
+        // object of mesh m being object m.
+        {
+            WorldMeshes group;
+            std::vector<const scene::Mesh*> parts;
+            std::uint32_t triangles = 0;
+            for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
+                if (!merged[m]) continue;
+                parts.push_back(&scene.meshes[m]);
+                group.objects.push_back(std::uint32_t(m));
+                group.first_triangle.push_back(triangles);
+                triangles += std::uint32_t(scene.meshes[m].triangles.size());
+            }
+            if (parts.size() > 1) group.index.emplace(std::span<const scene::Mesh* const>(parts));
+            if (!parts.empty()) world_meshes_.push_back(std::move(group));
+        }
+        std::vector<Aabb<Real>> boxes;
+        for (std::uint32_t object = 0; object < placements_.size(); ++object) {
+            bounds_.extend(placements_[object].world_bounds);
+            if (object < merged.size() && merged[object]) continue;
+            top_objects_.push_back(object);
+            boxes.push_back(placements_[object].world_bounds);
+        }
+        // One object per leaf where the index takes the option: testing an object (a
+        // transform, then its mesh's own BVH or its sphere) costs far more than the box test
+        // that could skip it. With the wide BVH's leaves of up to 8, a scene of a few objects
+        // was one leaf, and every ray entered every object (hw2 ellipsoids, the course's
+        // Cornell boxes: 1.0-1.3x the time of the binary BVH before the wide one).
+        BvhBuildOptions top_options;
+        top_options.max_leaf_size = 1;
+        if constexpr (requires { Index::build(boxes, top_options); }) top_ = Index::build(boxes, top_options);
+        else top_ = Index::build(boxes);
+        direct_.choose(scene, top_objects_, placements_, spheres_, meshes_);
+        choose_direct_world_meshes();
+    }
+
+    // The objects as this index placed them (place_objects), for the surfaces that pair with it.
+    std::span<const Placement<Real>> placements() const { return placements_; }
+    // The order in which hits name mesh m's triangles (Hit::primitive): its own index's slots,
+    // or the file's (empty) for a mesh merged into a world-space index, whose hits are
+    // attributed to their meshes in the file's numbering.
+    std::span<const std::uint32_t> slot_order(std::size_t m) const {
+        if (meshes_[m]) return meshes_[m]->slot_order();
+        return {};
+    }
+    Aabb<Real> bounds() const { return bounds_; }
+    // The indices of both levels, the merged world-space index, and the triangles their leaves
+    // test (bench/scaling_bench.cpp).
+    std::size_t accelerator_bytes() const {
+        std::size_t total = top_.memory_bytes();
+        for (const auto& mesh : meshes_)
+            if (mesh) total += mesh->accelerator_bytes();
+        for (const auto& group : world_meshes_)
+            if (group.index) total += group.index->accelerator_bytes();
+        return total;
+    }
+    // How many meshes share one world-space index instead of a top-level entry each.
+    std::size_t merged_mesh_count() const {
+        std::size_t count = 0;
+        for (const auto& group : world_meshes_) count += group.objects.size();
+        return count;
+    }
+
+    // The one closest-hit entry (geometry/ray_batch.hpp): for each active ray, the closest hit in
+    // (t_min, t_max], its t_max lowered to it and hits[i] filled; bit i set where rays[i] hits.
+    // The batch's culling rule names the surfaces skipped when met from behind
+    // (geometry/backface_culling.hpp). Every ray's hit is the one it gets alone, to the bit,
+    // however the batch is traversed (closest_many decides): a hit depends on the order in
+    // which leaves are visited only when two candidates tie, and a ray whose hit in a lane
+    // traversal came at exactly the t_max it was given is traced again on its own.
+    // A batch of one is inlined into the caller down to closest_one's dispatch.
+    [[gnu::always_inline]] std::uint32_t intersect(const RayBatch<Real>& batch, Hit<Real>* hits) const {
+        if (batch.count == 1) {
+            if (!(batch.active & 1)) return 0;
+            switch (batch.culling) {
+                case BackfaceCulling::none: break;
+                case BackfaceCulling::triangles: return closest_one<BackfaceCulling::triangles>(batch.rays[0], hits[0]);
+                case BackfaceCulling::all: return closest_one<BackfaceCulling::all>(batch.rays[0], hits[0]);
+            }
+            return closest_one<BackfaceCulling::none>(batch.rays[0], hits[0]);
+        }
+        return closest_many(batch, hits);
+    }
+
+    // The one any-hit entry: bit i set where something lies in (t_min, t_max) of active ray i
+    // (open at t_max: a shadow ray aimed at a point on a surface is not blocked by it).
+    [[gnu::always_inline]] std::uint32_t occluded(const RayBatch<Real>& batch) const {
+        if (batch.count == 1) return (batch.active & 1) && occluded_one(batch.rays[0]);
+        return occluded_many(batch);
+    }
+
+    // The one rule for how a batch of several rays is traversed, closest and any hits alike:
+    // with triangle packets, a scene whose direct form tests its leaves and spheres with a ray
+    // in each lane (intersection_batches) takes them so; a scene with an index (no direct form)
+    // takes up to index_lanes rays through it together (the nodes' tests of several rays then
+    // overlap instead of each waiting on the one before); elsewhere (roots of two leaves or
+    // top-level meshes tested directly, no packets) the rays go one by one.
+    BatchRoute route() const {
+        if constexpr (Mesh::packed) {
+            if (intersection_batches()) return BatchRoute::leaf_lanes;
+            if (!direct_form_) return BatchRoute::index_lanes;
+        }
+        return BatchRoute::ray_by_ray;
+    }
+
+
+private:
+    // One ray's closest hit. The small scenes' direct form is a dispatch to two out-of-line
+    // functions, and is inlined into the caller; the indexed form stays one out-of-line
+    // function. GCC weighed the two as one: once the kernel's slab test changed size it stopped
+    // inlining the whole, and every camera ray of the sphere scenes paid a call and its spills
+    // (3% of hw1 simple_shading's CPU time, 8-13% of hw1 two_spheres').
+    template <BackfaceCulling Culling>
+    [[gnu::always_inline]] bool closest_one(Ray<Real>& ray, Hit<Real>& hit) const {
+        if (direct_form_) {
+            const bool found = !world_meshes_.empty() && (two_leaves_ ? intersect_world_leaves<Culling, true>(ray, hit)
+                                                                       : intersect_world_leaves<Culling, false>(ray, hit));
+            return closest_direct<Culling>(ray, hit, found);
+        }
+        return intersect_indexed<Culling>(ray, hit);
+    }
+
+    // A batch of several rays, traversed as route() says: side by side, the active rays first
+    // gathered to the front if the mask has gaps (closest_dense), or ray by ray.
+    std::uint32_t closest_many(const RayBatch<Real>& batch, Hit<Real>* hits) const {
+        switch (batch.culling) {
+            case BackfaceCulling::none: break;
+            case BackfaceCulling::triangles: return closest_gathered<BackfaceCulling::triangles>(batch, hits);
+            case BackfaceCulling::all: return closest_gathered<BackfaceCulling::all>(batch, hits);
+        }
+        return closest_gathered<BackfaceCulling::none>(batch, hits);
+    }
+    template <BackfaceCulling Culling>
+    std::uint32_t closest_gathered(const RayBatch<Real>& batch, Hit<Real>* hits) const {
+        const BatchRoute way = route();
+        if (way == BatchRoute::ray_by_ray) {
+            std::uint32_t found = 0;
+            for (std::uint32_t lanes = batch.active; lanes != 0; lanes &= lanes - 1) {
+                const int i = std::countr_zero(lanes);
+                if (closest_one<Culling>(batch.rays[i], hits[i])) found |= std::uint32_t(1) << i;
+            }
+            return found;
+        }
+        if (batch.dense()) return closest_dense<Culling>(way, batch.rays, hits, batch.count);
+        Gathered gathered(batch);
+        Hit<Real> gathered_hits[RayBatch<Real>::max_rays];
+        for (int k = 0; k < gathered.count; ++k) gathered_hits[k] = hits[gathered.index[k]];
+        const std::uint32_t found = closest_dense<Culling>(way, gathered.rays, gathered_hits, gathered.count);
+        for (int k = 0; k < gathered.count; ++k) {
+            batch.rays[gathered.index[k]].t_max = gathered.rays[k].t_max;
+            hits[gathered.index[k]] = gathered_hits[k];
+        }
+        return gathered.scatter(found);
+    }
+
+    // The any-hit query of one ray.
+    [[gnu::always_inline]] bool occluded_one(const Ray<Real>& ray) const {
+        if (direct_form_) return occluded_without_index(ray);
+        return occluded_indexed(ray);
+    }
+    // Several rays, as route() says: side by side, or ray by ray over the active mask.
+    std::uint32_t occluded_many(const RayBatch<Real>& batch) const {
+        const BatchRoute way = route();
+        if (way == BatchRoute::ray_by_ray) {
+            std::uint32_t blocked = 0;
+            for (std::uint32_t lanes = batch.active; lanes != 0; lanes &= lanes - 1) {
+                const int lane = std::countr_zero(lanes);
+                if (occluded_one(batch.rays[lane])) blocked |= std::uint32_t(1) << lane;
+            }
+            return blocked;
+        }
+        if (batch.dense()) return occluded_dense(way, batch.rays, batch.count);
+        Gathered gathered(batch);
+        return gathered.scatter(occluded_dense(way, gathered.rays, gathered.count));
+    }
+
+    // A batch's active rays gathered to the front, for the side-by-side routes, which take
+    // rays[0, count); scatter takes an answer's bits back to the rays' own.
+    struct Gathered {
+        Ray<Real> rays[RayBatch<Real>::max_rays];
+        int index[RayBatch<Real>::max_rays];
+        int count = 0;
+        explicit Gathered(const RayBatch<Real>& batch) {
+            for (std::uint32_t lanes = batch.active; lanes != 0; lanes &= lanes - 1, ++count) {
+                index[count] = std::countr_zero(lanes);
+                rays[count] = batch.rays[index[count]];
+            }
+        }
+        std::uint32_t scatter(std::uint32_t bits) const {
+            std::uint32_t answer = 0;
+            for (; bits != 0; bits &= bits - 1) answer |= std::uint32_t(1) << index[std::countr_zero(bits)];
+            return answer;
+        }
+    };
+
+    // intersect through the top-level index (scenes that chose no direct form).
+    template <BackfaceCulling Culling>
+    bool intersect_indexed(Ray<Real>& ray, Hit<Real>& hit) const {
+        const TraversalRay traversal_ray(ray);
+        std::optional<TriangleRay> world_triangle_ray;  // made when the ray first enters a mesh
+        // The merged world-space meshes first: their hit lowers t_max before the top level
+        // tests any box.
+        bool found = false;
+        std::optional<RayBoxPrecomputed<Real>> box_ray;  // made once, for the first group's box
+        for (const WorldMeshes& group : world_meshes_) {
+            const Mesh& index = index_of(group);
+            const bool cull = culls_back_faces(Culling);
+            bool group_hit = false;
+            if (group.leaves) {
+                if constexpr (Mesh::packed) {
+                    group_hit = cull ? intersect_root_leaves<true, true>(index, *group.leaves, ray, world_triangle_ray, hit)
+                                     : intersect_root_leaves<false, true>(index, *group.leaves, ray, world_triangle_ray, hit);
+                }
+            } else {
+                if (!enters(index, ray, traversal_ray, box_ray)) continue;
+                if (!world_triangle_ray) world_triangle_ray.emplace(ray);
+                group_hit = cull ? index.template intersect<true>(ray, traversal_ray, *world_triangle_ray, ray.t_max, hit)
+                                 : index.template intersect<false>(ray, traversal_ray, *world_triangle_ray, ray.t_max, hit);
+            }
+            if (group_hit) {
+                if (group.index) group.attribute(index.source_triangle(hit.primitive), hit);
+                else hit.object = group.objects[0];
+                found = true;
+            }
+        }
+        return intersect_top<Culling>(ray, hit, found, traversal_ray, world_triangle_ray);
+    }
+
+    // occluded_one in a scene with an index (no direct form).
+    bool occluded_indexed(const Ray<Real>& ray) const {
+        const TraversalRay traversal_ray(ray);
+        std::optional<TriangleRay> world_triangle_ray;
+        std::optional<RayBoxPrecomputed<Real>> box_ray;
+        for (const WorldMeshes& group : world_meshes_) {
+            const Mesh& index = index_of(group);
+            if (!enters(index, ray, traversal_ray, box_ray)) continue;
+            if (!world_triangle_ray) world_triangle_ray.emplace(ray);
+            if (index.occluded(ray, traversal_ray, *world_triangle_ray, ray.t_max)) return true;
+        }
+        if (direct_.chosen()) return occluded_direct(ray);
+        const auto& order = top_.primitive_indices();
+        const bool blocked =
+            !top_objects_.empty() &&
+            top_.traverse_any(traversal_ray, ray.t_min, ray.t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_max) {
+                for (std::uint32_t i = first; i < first + count; ++i)
+                    if (occludes(placements_[top_objects_[order[i]]], ray, traversal_ray, world_triangle_ray, t_max))
+                        return true;
+                return false;
+            });
+        return blocked || planes_.occludes(ray);
+    }
+
+    // Whether closest_dense tests its rays side by side: scenes without an index (direct_form_)
+    // whose world-space meshes, if any, are each one leaf, under the packed watertight test,
+    // and whose top level holds no mesh. The camera rays of hw1's small scenes (a floor of two
+    // triangles under spheres, spheres alone) are such rays. A root of two leaves keeps
+    // intersect's own tie rule (intersect_root_leaves); a top-level mesh (a transformed plate)
+    // needs each ray's may_hit for its lane, which the spheres' lanes would only repeat (hw2
+    // simple_transform, two rotated meshes and a sphere: 1.04 of the CPU time with them).
+    bool intersection_batches() const {
+        if constexpr (Mesh::packed) {
+            if constexpr (Mesh::Packets::tests_ray_lanes) return direct_form_ && !two_leaves_ && !direct_.has_meshes();
+        }
+        return false;
+    }
+
+    // Batches side by side (geometry/scene_index_lanes.hpp).
+    static constexpr int index_lanes = 16;
+    template <BackfaceCulling Culling>
+    std::uint32_t closest_dense(BatchRoute way, Ray<Real>* rays, Hit<Real>* hits, int count) const;
+    std::uint32_t occluded_dense(BatchRoute way, const Ray<Real>* rays, int count) const;
+    template <BackfaceCulling Culling>
+    std::uint32_t intersect_through_index(Ray<Real>* rays, Hit<Real>* hits, int count) const
+        requires Mesh::packed;
+    template <BackfaceCulling Culling>
+    std::uint32_t intersect_in_object_space(const Placement<Real>& instance, const Ray<Real>* rays, const Real* t_min,
+                                            Real* t_max, std::uint32_t lanes, Hit<Real>* hits, std::uint32_t& tied) const
+        requires Mesh::packed;
+    std::uint32_t occluded_through_index(const Ray<Real>* rays, int count) const
+        requires Mesh::packed;
+    std::uint32_t occludes_in_object_space(const Placement<Real>& instance, const Ray<Real>* rays, const Real* t_min,
+                                           const Real* t_max, std::uint32_t lanes) const
+        requires Mesh::packed;
+    struct ObjectSpaceRays;
+    struct WorldSpaceRays;
+    [[gnu::always_inline]] static std::uint32_t lanes_reaching(const typename Mesh::Leaf& leaf, const Ray<Real>* rays,
+                                                               int n, std::uint32_t skip);
+    template <class Packets>
+    [[gnu::always_inline]] static typename Packets::LanePack lanes_t_max(const Ray<Real>* rays, int n);
+
+    using Kind = typename Placement<Real>::Kind;
+    using Direct = DirectTopLevel<Real, Mesh>;
+    // The top level and every mesh share one index type, so one prepared ray serves both.
+    using TraversalRay = typename Index::TraversalRay;
+    using TriangleRay = typename Mesh::TriangleRay;
+
+    const Mesh& mesh_at(std::uint32_t shape) const { return *meshes_[shape]; }
+
+    // The meshes that share the world's space at every instant (no transformation, not
+    // moving) go into one index over all their triangles, as Embree builds one BVH over a
+    // scene's geometries: a ray then enters one tree instead of each overlapping mesh's tree
+    // from the top level. A mesh that a MeshInstance places keeps its own index for the
+    // instance to use. Brute force (PrimitiveList) has no levels to save, and Embree's shapes
+    // (accel/embree.hpp) keep one mesh per object.
+    static std::vector<bool> merged_meshes(const scene::Scene& scene) {
+        std::vector<bool> merged(scene.meshes.size(), false);
+        if constexpr (std::is_same_v<Index, PrimitiveList<Real>>) return merged;
+        std::vector<bool> instanced(scene.meshes.size(), false);
+        for (const auto& instance : scene.mesh_instances) instanced[instance.base_mesh] = true;
+        for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
+            const scene::Mesh& mesh = scene.meshes[m];
+            merged[m] = !instanced[m] && mesh.transform == glm::dmat4(1.0) && (!MotionBlur || mesh.motion == glm::dvec3(0.0));
+        }
+        return merged;
+    }
+
+    // intersect_indexed past the world meshes: the top level (direct or through its index),
+    // then the planes; `found` whether the world meshes were hit.
+    template <BackfaceCulling Culling>
+    [[gnu::always_inline]] bool intersect_top(Ray<Real>& ray, Hit<Real>& hit, bool found, const TraversalRay& traversal_ray,
+                                              std::optional<TriangleRay>& world_triangle_ray) const {
+        if (direct_.chosen()) return closest_direct<Culling>(ray, hit, found);
+        if (top_objects_.empty()) return planes_.template closest<Culling>(ray, hit) || found;
+        const auto& order = top_.primitive_indices();
+        top_.traverse_closest(traversal_ray, ray.t_min, ray.t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_max) {
+            bool leaf_hit = false;
+            for (std::uint32_t i = first; i < first + count; ++i) {
+                const std::uint32_t object = top_objects_[order[i]];
+                if (intersect_instance<Culling>(placements_[object], ray, traversal_ray, world_triangle_ray, t_max, hit)) {
+                    hit.object = object;
+                    leaf_hit = true;
+                }
+            }
+            found |= leaf_hit;
+            return leaf_hit;
+        });
+        return planes_.template closest<Culling>(ray, hit) || found;
+    }
+
+    // The direct top level's closest hit, then the planes'; `found`: something nearer was hit.
+    template <BackfaceCulling Culling>
+    [[gnu::always_inline]] bool closest_direct(Ray<Real>& ray, Hit<Real>& hit, bool found) const {
+        found = direct_.template closest<Culling>(ray, hit, found);
+        return planes_.template closest<Culling>(ray, hit) || found;
+    }
+    [[gnu::always_inline]] bool occluded_direct(const Ray<Real>& ray) const {
+        return direct_.occludes(ray) || planes_.occludes(ray);
+    }
+
+    // Whether the ray meets the box of a world-space index within its interval, by the same
+    // conservative slab test as the BVHs (Ize's widened exit): the triangle set-up is then made
+    // before the index is entered (eagerly, outside the kernel's leaf loop) and only for rays
+    // that may reach a leaf, as the top level's box test did for a mesh in it.
+    // A wide BVH tests its root's children with the traversal ray instead (WideBvhTree::enters):
+    // no division of its own, and rays between the children's boxes are stopped too.
+    static bool enters(const Mesh& index, const Ray<Real>& ray, const TraversalRay& traversal_ray,
+                       std::optional<RayBoxPrecomputed<Real>>& box_ray) {
+        if constexpr (requires { index.enters(traversal_ray, ray.t_min, ray.t_max); }) {
+            return index.enters(traversal_ray, ray.t_min, ray.t_max);
+        } else {
+            if (!box_ray) box_ray.emplace(ray);
+            return intersect_box(index.bounds(), *box_ray, ray.t_min, ray.t_max, robust_far_scale<Real>) != infinity<Real>;
+        }
+    }
+
+    // Forced inline, as occludes below: the top level's leaf callbacks call them for every
+    // object they reach, and with to_object forced inline GCC put both out of line (nm).
+    template <BackfaceCulling Culling>
+    [[gnu::always_inline]] bool intersect_instance(const Placement<Real>& instance, const Ray<Real>& ray,
+                                                   const TraversalRay& traversal_ray,
+                                                   std::optional<TriangleRay>& world_triangle_ray, Real& t_max,
+                                                   Hit<Real>& hit) const {
+        if (instance.kind == Kind::mesh) {
+            const auto& mesh = mesh_at(instance.shape);
+            const bool cull = culls_back_faces(Culling);
+            if (instance.template in_world_space<MotionBlur>()) {
+                if (!world_triangle_ray) world_triangle_ray.emplace(ray);
+                return cull ? mesh.template intersect<true>(ray, traversal_ray, *world_triangle_ray, t_max, hit)
+                            : mesh.template intersect<false>(ray, traversal_ray, *world_triangle_ray, t_max, hit);
+            }
+            const Ray<Real> local = instance.template ray_to_object<MotionBlur>(ray);
+            return cull ? mesh.template intersect<true>(local, t_max, hit) : mesh.template intersect<false>(local, t_max, hit);
+        }
+        const Ray<Real> local = instance.template ray_to_object<MotionBlur>(ray);
+        Real t;
+        if (!spheres_[instance.shape].intersect(local, ray.t_min, t_max, t)) return false;
+        t_max = t;
+        // The whole record, barycentrics too: what a hit leaves is then the same whichever
+        // hits it replaced (intersect_through_index takes them in another order).
+        hit.t = t;
+        hit.primitive = 0;
+        hit.b1 = hit.b2 = 0;
+        return true;
+    }
+
+    [[gnu::always_inline]] bool occludes(const Placement<Real>& instance, const Ray<Real>& ray, const TraversalRay& traversal_ray,
+                  std::optional<TriangleRay>& world_triangle_ray, Real t_max) const {
+        if (instance.kind == Kind::mesh && instance.template in_world_space<MotionBlur>()) {
+            if (!world_triangle_ray) world_triangle_ray.emplace(ray);
+            return mesh_at(instance.shape).occluded(ray, traversal_ray, *world_triangle_ray, t_max);
+        }
+        const Ray<Real> local = instance.template ray_to_object<MotionBlur>(ray);
+        if (instance.kind == Kind::mesh) return mesh_at(instance.shape).occluded(local, t_max);
+        Real t;
+        return spheres_[instance.shape].intersect(local, ray.t_min, t_max, t) && t < t_max;
+    }
+
+    // A scene whose top level is tested without its index (direct spheres, or nothing but the
+    // world-space meshes and planes) and whose world-space indices are each one leaf (at most N
+    // triangles: the course's floors, walls and mirrors of two to six) is tested without the
+    // TraversalRay: each index's leaf directly (TriangleMesh::intersect_leaf), then the spheres
+    // and planes. The TraversalRay (three divisions, broadcast) and the root's box test were
+    // a fifth of hw1 simple_reflectance's profile (a two-triangle floor and one sphere). An
+    // index whose root holds two leaves is tested leaf by leaf too (intersect_root_leaves:
+    // hw1 ocornellbox's ten wall triangles, where the TraversalRay, the root's test made twice
+    // and the traversal were 15% of the profile). The
+    // hits are the index's: traversal of a single leaf tests that leaf, in the same slot order
+    // with the same t_max; only a ray whose box test the index would fail is now tested too,
+    // and the conservative box (Ize's widened exit) fails only rays that miss the triangles.
+    // A scene with a top-level index keeps it, and its TraversalRay, but its world-space
+    // indices of one or two leaves are still tested leaf by leaf (intersect_indexed): hw2
+    // horse_instanced's two-triangle floor had cost each camera ray a root test and a
+    // traversal of their own, 7% of its instructions.
+    void choose_direct_world_meshes() {
+        for (WorldMeshes& group : world_meshes_) group.leaves = index_of(group).root_leaves();
+        if (!top_objects_.empty() && !direct_.chosen()) return;
+        bool two_leaves = false;
+        for (const WorldMeshes& group : world_meshes_) {
+            if (!group.leaves) return;
+            two_leaves |= group.leaves->count == 2;
+        }
+        direct_form_ = true;
+        two_leaves_ = two_leaves;
+    }
+
+    // The world-space meshes' leaves for intersect's direct path: hit or not, and hit filled as
+    // intersect's loop over the indices fills it.
+    // TwoLeaves: some index has two (two_leaves_); without it, the one-leaf code alone.
+    template <BackfaceCulling Culling, bool TwoLeaves>
+    bool intersect_world_leaves(Ray<Real>& ray, Hit<Real>& hit) const {
+        if constexpr (Mesh::packed) {
+            std::optional<TriangleRay> triangle_ray;  // made for the first leaf the ray may reach
+            bool found = false;
+            for (const WorldMeshes& group : world_meshes_) {
+                const Mesh& index = index_of(group);
+                const bool cull = culls_back_faces(Culling);
+                const bool group_hit = cull ? intersect_root_leaves<true, TwoLeaves>(index, *group.leaves, ray, triangle_ray, hit)
+                                            : intersect_root_leaves<false, TwoLeaves>(index, *group.leaves, ray, triangle_ray, hit);
+                if (group_hit) {
+                    if (group.index) group.attribute(index.source_triangle(hit.primitive), hit);
+                    else hit.object = group.objects[0];
+                    found = true;
+                }
+            }
+            return found;
+        } else {
+            return false;  // root_leaves() is empty without packets: direct_form_ stays false
+        }
+    }
+
+    // One index's closest hit from its root's one or two leaves, the hit its traversal finds.
+    // Two leaves are each tested up to the ray's own t_max, without their boxes' order: a leaf's
+    // test keeps its closest candidate at or below t_max (later slots winning ties), so under
+    // the lower t_max the nearer leaf's hit leaves the farther one, it is the same candidate
+    // where it passes, and the strictly nearer of the two hits is what either order of visits
+    // ends with. Only equal distances depend on the order (the later leaf wins), and the
+    // traversal orders leaves by their boxes' entry distances: those rays (an edge shared by
+    // the two leaves) are handed to the traversal itself, from the state before either leaf.
+    template <bool CullBackfaces, bool TwoLeaves>
+    [[gnu::always_inline]] static bool intersect_root_leaves(const Mesh& index, const typename Mesh::RootLeaves& leaves,
+                                                             Ray<Real>& ray, std::optional<TriangleRay>& triangle_ray,
+                                                             Hit<Real>& hit) {
+        const auto& first = leaves.leaf[0];
+        if (!TwoLeaves || leaves.count == 1) {
+            if (leaves_box(first.box, ray)) return false;
+            if (!triangle_ray) triangle_ray.emplace(ray);
+            return index.template intersect_leaf<CullBackfaces>(ray, *triangle_ray, first, ray.t_max, hit);
+        }
+        const auto& second = leaves.leaf[1];
+        const bool may_first = !leaves_box(first.box, ray), may_second = !leaves_box(second.box, ray);
+        if (!may_first && !may_second) return false;
+        if (!triangle_ray) triangle_ray.emplace(ray);
+        Real t_first = ray.t_max, t_second = ray.t_max;
+        Hit<Real> hit_first = hit, hit_second = hit;
+        const bool found_first =
+            may_first && index.template intersect_leaf<CullBackfaces>(ray, *triangle_ray, first, t_first, hit_first);
+        const bool found_second =
+            may_second && index.template intersect_leaf<CullBackfaces>(ray, *triangle_ray, second, t_second, hit_second);
+        if (found_first && found_second && t_first == t_second)
+            return index.template intersect<CullBackfaces>(ray, TraversalRay(ray), *triangle_ray, ray.t_max, hit);
+        if (found_second && (!found_first || t_second < t_first)) {
+            ray.t_max = t_second;
+            hit = hit_second;
+            return true;
+        }
+        if (!found_first) return false;
+        ray.t_max = t_first;
+        hit = hit_first;
+        return true;
+    }
+
+    // occluded for direct_form_: the world meshes' leaves, then the direct top level and planes.
+    [[gnu::always_inline]] bool occluded_without_index(const Ray<Real>& ray) const {
+        return (!world_meshes_.empty() && (two_leaves_ ? occluded_world_leaves<true>(ray) : occluded_world_leaves<false>(ray))) ||
+               occluded_direct(ray);
+    }
+
+    template <bool TwoLeaves>
+    bool occluded_world_leaves(const Ray<Real>& ray) const {
+        if constexpr (Mesh::packed) {
+            std::optional<TriangleRay> triangle_ray;
+            for (const WorldMeshes& group : world_meshes_) {
+                const Mesh& index = index_of(group);
+                for (int i = 0; i < (TwoLeaves ? group.leaves->count : 1); ++i) {
+                    const auto& leaf = group.leaves->leaf[std::size_t(i)];
+                    if (leaves_box(leaf.box, ray)) continue;
+                    if (!triangle_ray) triangle_ray.emplace(ray);
+                    if (index.occluded_leaf(ray, *triangle_ray, leaf, ray.t_max)) return true;
+                }
+            }
+        }
+        return false;
+    }
+
+    // The merged meshes and the index over their triangles.
+    struct WorldMeshes {
+        // Over the parts' triangles, numbered part after part; none for a single part, which
+        // is traversed through its own mesh's index (and keeps its index order).
+        std::optional<Mesh> index;
+        std::vector<std::uint32_t> objects;         // per part, its object (Hit::object)
+        std::vector<std::uint32_t> first_triangle;  // per part, the number of its first triangle
+        std::optional<typename Mesh::RootLeaves> leaves;  // the index's leaves, when its root has only one or two (direct_form_)
+
+        // The hit on triangle `number` of the index (hit.primitive holds the index's slot)
+        // as a hit on its own mesh: its object, its triangle there (the file's order, in which
+        // its surface keeps them: SceneIndex::slot_order).
+        void attribute(std::uint32_t number, Hit<Real>& hit) const {
+            const std::size_t part =
+                std::size_t(std::upper_bound(first_triangle.begin(), first_triangle.end(), number) - first_triangle.begin()) - 1;
+            hit.object = objects[part];
+            hit.primitive = number - first_triangle[part];
+        }
+    };
+    // The index a world group is traversed through: its merged index, or its one part's own.
+    const Mesh& index_of(const WorldMeshes& group) const { return group.index ? *group.index : mesh_at(group.objects[0]); }
+
+    std::vector<std::optional<Mesh>> meshes_;  // none for a mesh merged into a world-space index
+    std::vector<Placement<Real>> placements_;
+    std::vector<SphereShape<Real>> spheres_;
+    std::vector<WorldMeshes> world_meshes_;
+    std::vector<std::uint32_t> top_objects_;  // the top level's primitives: the objects not merged
+    Direct direct_;  // the top level without its index, where chosen
+    bool direct_form_ = false;  // no TraversalRay: the top level direct, the world meshes' leaves too
+    bool two_leaves_ = false;   // some world-space index of the direct form has a root of two leaves
+    PlaneSet<Real> planes_;
+    Aabb<Real> bounds_;
+    Index top_;
+};
+
+}  // namespace prism
+
+#include <prism/geometry/scene_index_lanes.hpp>
