@@ -50,7 +50,7 @@ struct RayBoxPrecomputed {
 
 // Ize, "Robust BVH Ray Traversal" (JCGT 2013): widening every far slab distance by 1 + 2
 // gamma(3) makes the box test conservative, so rounding never culls a box the ray enters. One
-// constant for every index that tests boxes (BvhTree, WideBvhTree, SceneGeometry's world meshes).
+// constant for every index that tests boxes (BvhTree, WideBvhTree, SceneIndex's world meshes).
 template <Scalar Real>
 inline constexpr Real robust_far_scale = Real(1) + 2 * gamma<Real>(3);
 

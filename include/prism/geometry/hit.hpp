@@ -15,7 +15,7 @@ struct Hit {
     std::uint32_t object = 0;     // index of the instance (or plane) hit
     // A triangle's position in its mesh's index order (TriangleMesh reorders triangles for
     // locality), not its position in scene::Mesh::triangles, except for a mesh that shares
-    // SceneGeometry's merged world-space index with others: it keeps the file's order. 0 for
+    // SceneIndex's merged world-space index with others: it keeps the file's order. 0 for
     // spheres and planes.
     std::uint32_t primitive = 0;
     Real b1 = 0, b2 = 0;          // barycentrics for triangles
@@ -41,7 +41,7 @@ struct SurfacePoint {
     Vec3<Real> local_position{0};  // in the object's own space (a sphere's (u, v) come from it)
     std::uint32_t material = 0;
     std::span<const std::uint32_t> textures;  // the object's textures (indices into Scene::textures)
-    // What SceneGeometry::spawn_origin needs to leave the surface by its error bound: the hit
+    // What SceneSurfaces::spawn_origin needs to leave the surface by its error bound: the hit
     // point in object space with its error, the object-space geometric normal, the object, and
     // the instant of the ray that found it.
     Vec3<Real> object_point{0}, object_error{0}, object_normal{0, 0, 1};

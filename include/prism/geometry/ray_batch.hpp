@@ -7,7 +7,7 @@
 //   answer is set where rays[i] is blocked.
 // One ray is a batch of one (closest_hit, blocked). How a batch is traversed (SIMD lanes, or
 // ray by ray) is the index's decision, taken in one place; whatever it decides, every ray's
-// answer is the one it gets alone, to the bit (the tie rule: SceneGeometry::intersect).
+// answer is the one it gets alone, to the bit (the tie rule: geometry/scene_index_lanes.hpp).
 #pragma once
 
 #include <prism/geometry/backface_culling.hpp>
@@ -38,7 +38,7 @@ struct RayBatch {
 
 // How an index traverses a batch of several rays: ray by ray, with a ray in each SIMD lane at
 // leaves tested directly, or several rays through the index together. Only the index chooses
-// (SceneGeometry::route); tests read its choice to know which traversal they check.
+// (SceneIndex::route); tests read its choice to know which traversal they check.
 enum class BatchRoute { ray_by_ray, leaf_lanes, index_lanes };
 
 // The culling rule of an integrator's rays: camera rays (depth 0) skip back faces as `culling`

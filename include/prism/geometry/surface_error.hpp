@@ -176,7 +176,7 @@ struct InstanceTransforms {
     Mat3<Real> round_trip_linear{0};
     Vec3<Real> round_trip_constant{0};
 
-    // Rounds the matrices exactly as SceneGeometry does, so A is the traversal's own matrix.
+    // Rounds the matrices exactly as Placement does, so A is the traversal's own matrix.
     explicit InstanceTransforms(const glm::dmat4& transform)
         : object_to_world(transform), world_to_object(glm::inverse(transform)) {
         // The bound is derived from the double matrices, never by widening the rounded ones back

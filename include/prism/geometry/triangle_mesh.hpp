@@ -95,7 +95,7 @@ public:
 
     // The slots [first, first + count) of the one leaf that holds every triangle, when the
     // index is a single leaf (a wide BVH over at most N triangles: a root with one child).
-    // SceneGeometry tests such a mesh's leaf directly (intersect_leaf, occluded_leaf), without
+    // SceneIndex tests such a mesh's leaf directly (intersect_leaf, occluded_leaf), without
     // the traversal ray or the root's box test that would only lead to it.
     struct Leaf {
         std::uint32_t first = 0, count = 0;
@@ -176,7 +176,7 @@ public:
     }
 
     // The same with the ray's traversal and triangle set-up made by the caller, who may share
-    // them between meshes in one space (SceneGeometry, for meshes in world space).
+    // them between meshes in one space (SceneIndex, for meshes in world space).
     template <bool CullBackfaces>
     bool intersect(const Ray<Real>& ray, const TraversalRay& traversal_ray, const TriangleRay& triangle_ray, Real& t_max,
                    Hit<Real>& hit) const {

@@ -59,7 +59,7 @@ public:
     // where its vertices leave at least that much of their last cache line unused (float: 288
     // bytes of vertices in a 320-byte packet), so the numbers cost no memory and sit on a line
     // the test has just read. A merged index looks its hit's number up after the traversal,
-    // and the separate array's load missed the cache: a fifth of SceneGeometry::intersect's
+    // and the separate array's load missed the cache: a fifth of SceneIndex::closest_one's
     // samples on the course's diffuse rays.
     static constexpr std::size_t vertex_bytes = 9 * N * sizeof(Storage);
     static constexpr bool keeps_sources =
@@ -125,7 +125,7 @@ public:
     }
 
     // The transposed test: several rays, one in each lane of a pack, against one triangle at a
-    // time (SceneGeometry::intersect_each: the camera rays of a row, whose closest hits among a
+    // time (SceneIndex::closest_dense: the camera rays of a row, whose closest hits among a
     // small scene's few triangles had cost a camera ray more instructions than its shading).
     // Each lane computes the scalar test's operations in the scalar test's order, on its own
     // ray's permuted axes and shear, so its edge functions, t and barycentrics are the scalar

@@ -16,8 +16,8 @@
 
 namespace prism {
 
-// The index SceneGeometry gives each object: the meshes in order, then the mesh instances,
-// then the spheres (geometry/scene_geometry.hpp builds its instances in this order).
+// The number each object has (Hit::object): the meshes in order, then the mesh instances,
+// then the spheres (place_objects, geometry/placement.hpp, numbers them in this order).
 inline std::uint32_t scene_object_of_mesh(const scene::Scene&, std::size_t mesh) { return std::uint32_t(mesh); }
 inline std::uint32_t scene_object_of_instance(const scene::Scene& scene, std::size_t instance) {
     return std::uint32_t(scene.meshes.size() + instance);

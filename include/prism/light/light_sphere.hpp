@@ -25,7 +25,7 @@ struct LightSphere {
     Mat3<Real> normal_to_world{1};  // M^-T
     Real determinant = 1;           // |det M|
     Vec3<Real> radiance{0};
-    std::uint32_t object = 0;  // SceneGeometry's index of the sphere
+    std::uint32_t object = 0;  // its object number (place_objects)
 
     static constexpr scene::LightKind kind = scene::LightKind::object;
 

@@ -86,11 +86,11 @@ public:
     // Camera rays several at a time, as the ray tracer takes them (WhittedIntegrator: their
     // closest hits first, then each ray's radiance from its hit), for the cameras of both
     // integrators. A path's camera hit is the one its own first intersection finds (the same
-    // culling rule, intersect_each's hits are intersect's), and the path goes on from it with
+    // culling rule; a batch's hits are each ray's own), and the path goes on from it with
     // the same draws: the same bits. Without these, a path-traced scene's ray-traced cameras
     // lost the ray tracer's batches (hw7 VeachAjar's first camera).
     // The Renderer batches only the ray-traced cameras: a path-traced camera's rays one by one. Its
-    // samples' camera rays side by side through the index (intersect_each) made hw7
+    // samples' camera rays as one batch through the index made hw7
     // path_diffuse and path_glass 1.02-1.04 times slower (their index has 3 leaves; paired, 5
     // rounds), while VeachAjar's ray-traced camera gains the ray tracer's rows and prelit lights.
     bool batches_camera_rays(const scene::Camera& camera) const {

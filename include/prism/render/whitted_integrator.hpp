@@ -13,10 +13,10 @@
 #include <prism/light/light_sample.hpp>
 #include <prism/light/light_set.hpp>
 #include <prism/light/point_light.hpp>
+#include <prism/light/point_light_lanes.hpp>
 #include <prism/material/fresnel.hpp>
 #include <prism/material/material.hpp>
 #include <prism/memory/unconstructed.hpp>
-#include <prism/simd/pack.hpp>
 #include <prism/render/integrator.hpp>
 #include <prism/render/stored_whole.hpp>
 #include <prism/sampling/random.hpp>
@@ -36,7 +36,7 @@ namespace prism {
 
 // How a ray leaving a surface is kept from finding that surface again.
 enum class RayOffset {
-    // From the hit point's floating-point error bound (SceneGeometry::spawn_origin): no
+    // From the hit point's floating-point error bound (SceneSurfaces::spawn_origin): no
     // scene-tuned number, right at any scale and in float and double alike.
     error_bound,
     // The course's: ShadowRayEpsilon along the shading normal, for every secondary ray.
@@ -88,7 +88,7 @@ inline constexpr bool textured = !std::is_same_v<Textures, NoTextures<Real>>;
 
 // The surface point at a hit, with (u, v) and tangents only where textures may read them, and
 // the exact point with its error bound only where rays leave by it (RayOffset::error_bound).
-// Inlined into trace, so that surface<false> is (SceneGeometry::surface).
+// Inlined into trace, so that surface<false> is (SceneSurfaces::surface).
 template <bool Textured, Scalar Real, class Geometry>
 [[gnu::always_inline]] inline SurfacePoint<Real> shading_surface(const Geometry& geometry, const Ray<Real>& ray, const Hit<Real>& hit,
                                    RayOffset offset) {
@@ -136,7 +136,7 @@ template <Scalar Real, class Geometry, class LightSetT, class Textures = NoTextu
           class Environment = NoEnvironment<Real>>
 class WhittedIntegrator {
     // The error-bounded origins of the rays leaving one surface point, one per side they leave
-    // by (SceneGeometry::spawn_side), each computed for the first ray that needs it: the shadow
+    // by (SceneSurfaces::spawn_side), each computed for the first ray that needs it: the shadow
     // rays to every light and the reflected and refracted rays share them. A mirror's reflected
     // ray leaves by the side its lit shadow rays left by, so it no longer computes the origin
     // again (offset_ray_origin was 3.7% of hw1 simple_reflectance's samples).
@@ -216,142 +216,13 @@ public:
     // The same rays, tests, draws and sums as radiance_at, so the same bits. Only where
     // prelights(): the scene has such a light.
     static constexpr int prelit_width = 16;
-    static_assert(prelit_width == row_width, "radiances_at makes point lights' rays as rows do (light_lanes)");
+    static_assert(prelit_width == row_width, "radiances_at makes point lights' rays as rows do (point_light_lanes)");
     static constexpr std::size_t prelit_lights = 8;
     bool prelights() const { return prelit_count_ > 0; }
     void radiances_at(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count, CameraPath& path,
-                      Vec3<Real>* radiance) const
-    {
-        // shade's state at a camera hit up to its direct lighting (the point made in place).
-        struct PrelitPoint {
-            SurfacePoint<Real> point;
-            Vec3<Real> normal{0};
-            SpawnOrigins origins{};
-            Real travelled = 0;
-            std::uint32_t visible = 0;  // bit k: prelit light k's shadow ray is made and reaches it
-            bool front_face = false, inside_medium = false;
-        };
-        Unconstructed<PrelitPoint, prelit_width> points;
-        // Textures change a copy of the material; without them it is read where it is stored.
-        std::conditional_t<textured<Textures, Real>, Unconstructed<Material<Real>, prelit_width>, std::monostate> copies;
-        const auto material_of = [&](int i) -> decltype(auto) {
-            if constexpr (textured<Textures, Real>) return copies[std::size_t(i)];
-            else return static_cast<const Material<Real>&>(materials_[points[std::size_t(i)].point.material]);
-        };
-        std::uint32_t shading = 0;  // the samples shaded below (not escaped, not unshaded by a texture)
-        std::uint32_t lighting = 0;  // the shading samples lit directly (outside a medium)
-        for (int i = 0; i < count; ++i) {
-            if (!((found >> i) & 1)) {
-                radiance[i] = escaped(rays[i].direction, 0, path.pixel_uv);
-                continue;
-            }
-            const Ray<Real>& ray = rays[i];
-            PrelitPoint& at = points.make_from(std::size_t(i), [&] {
-                return PrelitPoint{shading_surface(geometry_, textures_, ray, hits[i], settings_.ray_offset)};
-            });
-            if constexpr (textured<Textures, Real>) copies.make(std::size_t(i), materials_[at.point.material]);
-            at.travelled = Real(0) + hits[i].t;
-            const RayCone<Real> cone{at.travelled * path.spread, std::abs(glm::dot(ray.direction, at.point.shading_normal))};
-            if (const std::optional<Vec3<Real>> unshaded = textures_.apply(at.point, material_of(i), cone)) {
-                radiance[i] = *unshaded;
-                continue;
-            }
-            at.front_face = glm::dot(at.point.geometric_normal, ray.direction) < 0;
-            at.normal = at.front_face ? at.point.shading_normal : -at.point.shading_normal;
-            at.inside_medium = !at.front_face && material_of(i).type == scene::MaterialType::dielectric;
-            shading |= std::uint32_t(1) << i;
-            if (!at.inside_medium) lighting |= std::uint32_t(1) << i;
-        }
-        // Each prelit light's samples and shadow rays across the samples, the rays side by side.
-        std::array<std::array<Vec3<Real>, prelit_width>, prelit_lights> directions, radiances;
-        std::array<std::array<Real, prelit_width>, prelit_lights> cosines;
-        std::size_t k = 0;
-        std::optional<RowPoints> row;  // the lighting points SoA, for the first point light
-        const auto origin_of = [&](std::size_t i, const Vec3<Real>& direction) {
-            PrelitPoint& at = points[i];
-            return leaving(at.point, at.normal, direction, at.point.time, at.origins).origin;
-        };
-        lights_.for_each([&](const auto& light) {
-            if constexpr (draws_nothing<std::decay_t<decltype(light)>>) {
-                if (k == prelit_lights || lighting == 0) return;
-                const std::size_t j = k++;
-                Unconstructed<Ray<Real>, prelit_width> shadows;
-                std::array<int, prelit_width> owner;
-                int n = 0;
-                if constexpr (std::is_same_v<std::decay_t<decltype(light)>, PointLight<Real>>) {
-                    // Point lights lane by lane, as shade_row makes them (light_lanes).
-                    if (!row) {
-                        row.emplace();
-                        for (std::uint32_t rest = lighting; rest != 0; rest &= rest - 1) {
-                            const int i = std::countr_zero(rest);
-                            const PrelitPoint& at = points[std::size_t(i)];
-                            for (int axis = 0; axis < 3; ++axis) {
-                                row->position[axis][i] = at.point.position[axis];
-                                row->normal[axis][i] = at.normal[axis];
-                            }
-                            row->time[i] = at.point.time;
-                        }
-                        row->shading = lighting;
-                    }
-                    Unconstructed<Ray<Real>, prelit_width> made;
-                    const std::uint32_t lit =
-                        light_lanes(light, *row, directions[j], radiances[j], cosines[j], made, origin_of);
-                    for (std::uint32_t rest = lit; rest != 0; rest &= rest - 1) {
-                        const int i = std::countr_zero(rest);
-                        shadows.make(std::size_t(n), made[std::size_t(i)]);
-                        owner[std::size_t(n++)] = i;
-                    }
-                } else {
-                    for (std::uint32_t rest = lighting; rest != 0; rest &= rest - 1) {
-                        const int i = std::countr_zero(rest);
-                        PrelitPoint& at = points[std::size_t(i)];
-                        const LightSample<Real> sample = light.sample(ShadingFrame<Real>{at.point.position, at.normal});
-                        directions[j][std::size_t(i)] = sample.direction;
-                        radiances[j][std::size_t(i)] = sample.radiance;
-                        cosines[j][std::size_t(i)] = glm::dot(at.normal, sample.direction);
-                        if (cosines[j][std::size_t(i)] <= 0) continue;
-                        make_shadow_ray(shadows.make(std::size_t(n)), at.point, at.normal, sample, at.origins);
-                        owner[std::size_t(n++)] = i;
-                    }
-                }
-                if (n == 0) return;
-                const std::uint32_t blocked = geometry_.occluded(RayBatch<Real>::all(shadows.data(), n));
-                for (int m = 0; m < n; ++m)
-                    if (!((blocked >> m) & 1)) points[std::size_t(owner[std::size_t(m)])].visible |= std::uint32_t(1) << j;
-            }
-        });
-        // Each sample shaded in its turn, as shade shades it.
-        for (std::uint32_t rest = shading; rest != 0; rest &= rest - 1) {
-            const int i = std::countr_zero(rest);
-            PrelitPoint& at = points[std::size_t(i)];
-            const Material<Real>& material = material_of(i);
-            Vec3<Real> color(0);
-            if (!at.inside_medium) {
-                color = geometry_.emitted(hits[i].object) + material.ambient * ambient_light_;
-                const Vec3<Real> to_viewer = -rays[i].direction;
-                Vec3<Real> direct(0);
-                std::size_t light_index = 0;  // among the prelit lights
-                lights_.for_each([&](const auto& light) {
-                    if constexpr (draws_nothing<std::decay_t<decltype(light)>>) {
-                        if (light_index < prelit_lights) {
-                            const std::size_t j = light_index++;
-                            path.random.template skip<Real>(2);
-                            if (!((at.visible >> j) & 1)) return;
-                            LightSample<Real> sample;
-                            sample.direction = directions[j][std::size_t(i)];
-                            sample.radiance = radiances[j][std::size_t(i)];
-                            direct += reflected(material, at.normal, to_viewer, sample, cosines[j][std::size_t(i)]);
-                            return;
-                        }
-                    }
-                    light_term(light, at.point, at.normal, to_viewer, material, path.random, at.origins, direct);
-                });
-                color += direct;
-            }
-            radiance[i] = reflect_and_absorb(rays[i], hits[i], at.point, material, at.normal, at.front_face,
-                                             at.inside_medium, color, 0, path, at.travelled, at.origins);
-        }
-    }
+                      Vec3<Real>* radiance) const;
+
+private:
 
     // The light types sampled without a draw (sample(at) alone).
     template <class L>
@@ -375,241 +246,14 @@ public:
     template <bool Primary>
         requires(!textured<Textures, Real> && std::is_same_v<LightSetT, LightSet<Real, PointLight>>)
     void shade_row(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count, CameraPath* paths,
-                   const Real* travelled, int depth, Vec3<Real>* radiance) const {
-        if constexpr (Primary) depth = 0;
-        const std::vector<PointLight<Real>>& lights = *lights_.template of_type<PointLight>();
-        // What shade knows of a point before its direct lighting (the point made in place, the
-        // rest of the record after it: value-initialised whole, the record had cost 5% of
-        // simple_shading's instructions), and per light what that lighting draws.
-        struct RowPoint {
-            SurfacePoint<Real> point;
-            Vec3<Real> normal, color;
-            SpawnOrigins origins;
-            std::uint32_t lit;  // bit k: light k's shadow ray is made
-            bool front_face, inside_medium;
-        };
-        Unconstructed<RowPoint, row_width> points;
-        std::array<std::array<Vec3<Real>, row_width>, row_lights> directions, radiances;
-        std::array<std::array<Real, row_width>, row_lights> cosines;
-        std::array<Unconstructed<Ray<Real>, row_width>, row_lights> shadows;  // per light, per ray
-        // The lights' samples and shadow rays are made lane by lane, a point in each
-        // (light_lanes), from the points gathered here.
-        RowPoints row{};
-        for (int i = 0; i < count; ++i) {
-            CameraPath& path = paths[i];
-            if (!((found >> i) & 1)) {
-                radiance[i] = escaped(rays[i].direction, depth, path.pixel_uv);
-                continue;
-            }
-            const Ray<Real>& ray = rays[i];
-            RowPoint& at = points.make_from(std::size_t(i), [&] {
-                return RowPoint{shading_surface<false>(geometry_, ray, hits[i], settings_.ray_offset)};
-            });
-            const Material<Real>& material = materials_[at.point.material];
-            at.front_face = glm::dot(at.point.geometric_normal, ray.direction) < 0;
-            at.normal = at.front_face ? at.point.shading_normal : -at.point.shading_normal;
-            at.inside_medium = !at.front_face && material.type == scene::MaterialType::dielectric;
-            if (at.inside_medium) continue;
-            at.color = geometry_.emitted(hits[i].object) + material.ambient * ambient_light_;
-            // direct_lighting's samples and shadow rays are made below, light by light across
-            // the row (light_lanes); the stream steps past their draws now, in the same order.
-            const Vec3<Real>& position = at.point.position;
-            for (std::size_t k = 0; k < lights.size(); ++k) path.random.template skip<Real>(2);
-            for (int axis = 0; axis < 3; ++axis) {
-                row.position[axis][i] = position[axis];
-                row.normal[axis][i] = at.normal[axis];
-            }
-            row.time[i] = at.point.time;
-            row.shading |= std::uint32_t(1) << i;
-        }
-        if (row.shading != 0) {
-            const auto origin_of = [&](std::size_t i, const Vec3<Real>& direction) {
-                RowPoint& at = points[i];
-                return leaving(at.point, at.normal, direction, at.point.time, at.origins).origin;
-            };
-            for (std::size_t k = 0; k < lights.size(); ++k) {
-                const std::uint32_t lit =
-                    light_lanes(lights[k], row, directions[k], radiances[k], cosines[k], shadows[k], origin_of);
-                for (std::uint32_t rest = lit; rest != 0; rest &= rest - 1)
-                    points[std::size_t(std::countr_zero(rest))].lit |= std::uint32_t(1) << k;
-            }
-        }
-        // Each light's shadow rays across the row, side by side.
-        std::array<std::uint32_t, row_width> blocked{};
-        for (std::size_t k = 0; k < lights.size(); ++k) {
-            Unconstructed<Ray<Real>, row_width> packed;
-            std::array<int, row_width> owner;
-            int n = 0;
-            for (int i = 0; i < count; ++i) {
-                if (!((found >> i) & 1) || !((points[std::size_t(i)].lit >> k) & 1)) continue;
-                packed.make(std::size_t(n), shadows[k][std::size_t(i)]);
-                owner[std::size_t(n++)] = i;
-            }
-            if (n == 0) continue;
-            for (std::uint32_t hit = geometry_.occluded(RayBatch<Real>::all(packed.data(), n)); hit != 0; hit &= hit - 1)
-                blocked[std::size_t(owner[std::size_t(std::countr_zero(hit))])] |= std::uint32_t(1) << k;
-        }
-        // Mirrors' and conductors' reflected rays, traced after the row's shading with their
-        // closest hits found as one batch (as trace's own intersection finds
-        // them below depth 0) and shaded as a row again, down to row_depth; each pixel draws
-        // from its own stream, so its draws keep their order.
-        Unconstructed<Ray<Real>, row_width> reflections;
-        Unconstructed<CameraPath, row_width> reflection_paths;
-        std::array<Vec3<Real>, row_width> weights;
-        std::array<Real, row_width> reached;  // travelled to the reflection's origin
-        std::array<int, row_width> reflecting;  // the ray's index in this row
-        int reflected_count = 0;
-        for (int i = 0; i < count; ++i) {
-            if (!((found >> i) & 1)) continue;
-            RowPoint& at = points[std::size_t(i)];
-            const Material<Real>& material = materials_[at.point.material];
-            if (!at.inside_medium) {
-                Vec3<Real> direct(0);
-                const Vec3<Real> to_viewer = -rays[i].direction;
-                for (std::uint32_t lit = at.lit & ~blocked[std::size_t(i)]; lit != 0; lit &= lit - 1) {
-                    const std::size_t k = std::size_t(std::countr_zero(lit));
-                    LightSample<Real> sample;
-                    sample.direction = directions[k][std::size_t(i)];
-                    sample.radiance = radiances[k][std::size_t(i)];
-                    direct += reflected(material, at.normal, to_viewer, sample, cosines[k][std::size_t(i)]);
-                }
-                at.color += direct;
-            }
-            CameraPath& path = paths[i];
-            const Real travelled_here = (Primary ? Real(0) : travelled[i]) + hits[i].t;  // shade's travelled += hit.t
-            if ((material.type == scene::MaterialType::mirror || material.type == scene::MaterialType::conductor) &&
-                depth < settings_.max_recursion_depth) {
-                // reflect_and_absorb's mirror and conductor, the trace deferred (no medium: only
-                // dielectrics have one).
-                const std::size_t j = std::size_t(reflected_count++);
-                Real cos_incident;
-                reflections.make(j, reflection_of(rays[i], at.point, material, at.normal, path, at.origins, cos_incident));
-                reflection_paths.make(j, path);
-                weights[j] = reflection_weight(material, cos_incident);
-                reached[j] = travelled_here;
-                reflecting[j] = i;
-                radiance[i] = at.color;
-                continue;
-            }
-            radiance[i] = reflect_and_absorb(rays[i], hits[i], at.point, material, at.normal, at.front_face,
-                                             at.inside_medium, at.color, depth, path, travelled_here, at.origins);
-        }
-        if (reflected_count == 0) return;
-        std::array<Hit<Real>, row_width> reflection_hits;
-        const std::uint32_t met = geometry_.intersect(RayBatch<Real>::all(reflections.data(), reflected_count), reflection_hits.data());
-        std::array<Vec3<Real>, row_width> traced;
-        if (depth + 1 < row_depth) {
-            shade_row<false>(reflections.data(), reflection_hits.data(), met, reflected_count, reflection_paths.data(),
-                             reached.data(), depth + 1, traced.data());
-        } else {
-            for (int j = 0; j < reflected_count; ++j) {
-                const Ray<Real>& reflection = reflections[std::size_t(j)];
-                CameraPath& path = reflection_paths[std::size_t(j)];
-                traced[std::size_t(j)] = ((met >> j) & 1) ? shade_apart(reflection, reflection_hits[std::size_t(j)],
-                                                                        depth + 1, path, reached[std::size_t(j)])
-                                                          : escaped(reflection.direction, depth + 1, path.pixel_uv);
-            }
-        }
-        for (int j = 0; j < reflected_count; ++j)
-            radiance[reflecting[std::size_t(j)]] += weights[std::size_t(j)] * traced[std::size_t(j)];
-    }
+                   const Real* travelled, int depth, Vec3<Real>* radiance) const;
 
-    // The shading points of a row, SoA, for light_lanes: bit i of `shading` for point i.
-    struct RowPoints {
-        alignas(64) Real position[3][row_width];
-        alignas(64) Real normal[3][row_width];
-        Real time[row_width];
-        std::uint32_t shading = 0;
-    };
-
-    // One point light's samples and shadow rays for the row's points, made as direct_lighting
-    // makes them point by point (PointLight::sample, then make_shadow_ray), with each lane
-    // computing the scalar code's operations in its order: the same directions, radiances,
-    // cosines and rays, bit for bit. The lit lanes are those the scalar `cos <= 0` test lets
-    // through (NaN included); returns them, whose rays are made. The square roots and
-    // divisions of sixteen points then share vector instructions (hw2 mirror_room: 0.88 of
-    // the wall time with the rays made point by point).
-    // `origin_of(i, direction)`: point i's shadow-ray origin where rays leave by their error
-    // bounds (leaving's, made lane by lane in the lit lanes' order); by the scene's epsilon the
-    // origins are made here, lane by lane as leaving_ray makes them.
-    template <class OriginOf>
-    std::uint32_t light_lanes(const PointLight<Real>& light, const RowPoints& row, std::array<Vec3<Real>, row_width>& directions,
-                              std::array<Vec3<Real>, row_width>& radiances, std::array<Real, row_width>& cosines,
-                              Unconstructed<Ray<Real>, row_width>& shadows, OriginOf origin_of) const {
-        constexpr int width = sizeof(Real) == 4 ? 16 : 8;
-        static_assert(row_width % width == 0);
-        using Lanes = simd::Pack<Real, width>;
-        std::uint32_t lit = 0;
-        for (int first = 0; first < row_width; first += width) {
-            const std::uint32_t shading = (row.shading >> first) & ((std::uint32_t(1) << width) - 1);
-            if (shading == 0) continue;
-            Lanes p[3], n[3], to_light[3];
-            for (int axis = 0; axis < 3; ++axis) {
-                p[axis] = Lanes::load(row.position[axis] + first);
-                n[axis] = Lanes::load(row.normal[axis] + first);
-                to_light[axis] = Lanes::broadcast(light.position[axis]) - p[axis];
-            }
-            // PointLight::sample: glm's dot sums (x + y) + z.
-            const Lanes distance_squared = (to_light[0] * to_light[0] + to_light[1] * to_light[1]) + to_light[2] * to_light[2];
-            const Lanes distance = simd::sqrt(distance_squared);
-            Lanes direction[3], radiance[3];
-            for (int axis = 0; axis < 3; ++axis) {
-                direction[axis] = to_light[axis] / distance;
-                radiance[axis] = Lanes::broadcast(light.intensity[axis]) / distance_squared;
-            }
-            const Lanes cosine = (n[0] * direction[0] + n[1] * direction[1]) + n[2] * direction[2];
-            const std::uint32_t lanes_lit = shading & (!(cosine <= Lanes::broadcast(Real(0)))).bits();
-            // Rows 0-2 the directions, 3-5 the radiances, 6-8 the origins, 9-11 the shadow rays'
-            // directions, 12 the cosines.
-            alignas(64) Real stored[13][width];
-            for (int axis = 0; axis < 3; ++axis) direction[axis].store(stored[axis]);
-            Lanes origin[3], aim[3];
-            if (settings_.ray_offset != RayOffset::error_bound) {
-                // leaving_ray: the origin on the side dot(direction, normal) >= 0 names (the same
-                // products as the cosine's, so the same sum).
-                const auto towards = cosine >= Lanes::broadcast(Real(0));
-                const Lanes epsilon = Lanes::broadcast(epsilon_);
-                for (int axis = 0; axis < 3; ++axis) origin[axis] = p[axis] + select(towards, n[axis], -n[axis]) * epsilon;
-            } else {
-                alignas(64) Real origins[3][width] = {};
-                for (std::uint32_t rest = lanes_lit; rest != 0; rest &= rest - 1) {
-                    const int lane = std::countr_zero(rest);
-                    const Vec3<Real> made =
-                        origin_of(std::size_t(first + lane), Vec3<Real>(stored[0][lane], stored[1][lane], stored[2][lane]));
-                    for (int axis = 0; axis < 3; ++axis) origins[axis][lane] = made[axis];
-                }
-                for (int axis = 0; axis < 3; ++axis) origin[axis] = Lanes::load(origins[axis]);
-            }
-            for (int axis = 0; axis < 3; ++axis) aim[axis] = (p[axis] + direction[axis] * distance) - origin[axis];
-            // unit_vector: v * (1 / sqrt(dot(v, v))); a light at infinity keeps the sample's direction.
-            const Lanes inverse_length =
-                Lanes::broadcast(Real(1)) / simd::sqrt((aim[0] * aim[0] + aim[1] * aim[1]) + aim[2] * aim[2]);
-            const auto finite = distance != Lanes::broadcast(infinity<Real>);
-            for (int axis = 0; axis < 3; ++axis) {
-                radiance[axis].store(stored[3 + axis]);
-                origin[axis].store(stored[6 + axis]);
-                select(finite, aim[axis] * inverse_length, direction[axis]).store(stored[9 + axis]);
-            }
-            cosine.store(stored[12]);
-            alignas(64) Real distances[width];
-            distance.store(distances);
-            for (std::uint32_t rest = shading; rest != 0; rest &= rest - 1) {
-                const int lane = std::countr_zero(rest);
-                const std::size_t i = std::size_t(first + lane);
-                directions[i] = Vec3<Real>(stored[0][lane], stored[1][lane], stored[2][lane]);
-                radiances[i] = Vec3<Real>(stored[3][lane], stored[4][lane], stored[5][lane]);
-                cosines[i] = stored[12][lane];
-                if (!((lanes_lit >> lane) & 1)) continue;
-                Ray<Real>& made = shadows.make(i);
-                made.origin = Vec3<Real>(stored[6][lane], stored[7][lane], stored[8][lane]);
-                made.direction = Vec3<Real>(stored[9][lane], stored[10][lane], stored[11][lane]);
-                made.t_min = Real(0);
-                made.t_max = distances[lane];
-                made.time = row.time[i];
-            }
-            lit |= lanes_lit << first;
-        }
-        return lit;
+    // The shading points of a row, SoA, for point_light_lanes.
+    using RowPoints = ShadingRow<Real, row_width>;
+    // Where rays leave by the scene's epsilon, that epsilon (point_light_lanes).
+    std::optional<Real> scene_epsilon() const {
+        if (settings_.ray_offset == RayOffset::error_bound) return std::nullopt;
+        return epsilon_;
     }
 
     // `travelled`: the distance from the camera to the ray's origin along the path, which widens
@@ -931,3 +575,5 @@ struct Whitted {
 };
 
 }  // namespace prism
+
+#include <prism/render/whitted_rows.hpp>
