@@ -1,8 +1,8 @@
 // Shadow rays side by side through an index (WideBvhTree::traverse_any_lanes,
-// SceneGeometry::occluded_side_by_side in scenes with a top-level index): each ray must reach
+// one batch through SceneGeometry::occluded in scenes with a top-level index): each ray must reach
 // exactly the leaves it reaches alone and get the answer occluded gives it alone, whatever rays
 // share its lanes. Camera rays side by side (WideBvhTree::traverse_closest_lanes,
-// SceneGeometry::intersect_each through the index) must get intersect's hits, ties included.
+// one batch through SceneGeometry::intersect) must get each ray's own hit, ties included.
 // And the world-space indices of one or two leaves, tested leaf by leaf in an index scene, must
 // give intersect's hits as the exhaustive test gives them.
 #include <prism/accel/accelerator.hpp>
@@ -316,7 +316,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: an index scene's one-leaf world mesh gives th
     CHECK(floor_hits > 5000);
 }
 
-// Camera rays side by side through the index (SceneGeometry::intersect_each in a scene with a
+// Camera rays side by side through the index (one batch through SceneGeometry::intersect in a scene with a
 // top-level index: intersect_through_index, WideBvhTree::traverse_closest_lanes): 1 to 32 rays,
 // a pixel's samples (nearly one direction), a row's, rays from anywhere, and rays aimed exactly
 // at the grids' vertices and edge midpoints, where neighbouring triangles tie and the leaves'
@@ -387,6 +387,27 @@ TEST_CASE_TEMPLATE("SceneGeometry: camera rays side by side through the index ge
                         edge_hits += a.b1 == 0 || a.b2 == 0 || a.b1 + a.b2 == 1;
                     }
                     rays += std::size_t(count);
+                    // With a random active mask, gaps included: the active rays as alone, the
+                    // others untouched.
+                    std::vector<prism::Ray<Real>> masked = start;
+                    const std::uint32_t mask = std::uint32_t(random()) & prism::RayBatch<Real>::all(masked.data(), count).active;
+                    std::vector<prism::Hit<Real>> masked_hits(static_cast<std::size_t>(count));
+                    for (auto& hit : masked_hits) hit.object = 12345;
+                    const std::uint32_t masked_found =
+                        geometry.intersect(prism::RayBatch<Real>{masked.data(), count, mask, Culling}, masked_hits.data());
+                    differ += masked_found != (expected & mask);
+                    for (int i = 0; i < count; ++i) {
+                        const std::size_t k = std::size_t(i);
+                        if (!((mask >> i) & 1)) {
+                            differ += !same_bits(masked[k].t_max, start[k].t_max) || masked_hits[k].object != 12345;
+                            continue;
+                        }
+                        differ += !same_bits(masked[k].t_max, alone[k].t_max);
+                        if ((expected >> i) & 1)
+                            differ += !same_bits(masked_hits[k].t, hits_alone[k].t) ||
+                                      masked_hits[k].object != hits_alone[k].object ||
+                                      masked_hits[k].primitive != hits_alone[k].primitive;
+                    }
                 };
                 compare.template operator()<BackfaceCulling::none>();
                 compare.template operator()<BackfaceCulling::triangles>();

@@ -7,7 +7,7 @@
 // their indices (their traversal ray, their root's box test), find the same hits, ties on the
 // quads' diagonals and rays that start on or graze their boxes' faces included; and planes,
 // tested eight at a time, give what each plane's own test gives, one after another; and shadow
-// rays tested several at a time (occluded_each) get what each gets alone.
+// rays tested several at a time (one batch through occluded) get what each gets alone.
 #include <prism/geometry/scene_geometry.hpp>
 #include <prism/material/material.hpp>
 
@@ -549,9 +549,9 @@ TEST_CASE_TEMPLATE("SceneGeometry: a world-space index whose root has two leaves
     CHECK(blocked > rays / 3);
 }
 
-// Shadow rays tested several at a time (SceneGeometry::occluded_each, a point's rays to its
-// lights; occluded_side_by_side, a ray in each lane): every ray of a batch, for any set of
-// lanes, gets what occluded gives it alone, in the
+// Shadow rays tested several at a time (a point's rays to its lights, a batch with gaps; a row's
+// rays, a ray in each lane): every ray of a batch, for any set of active rays, gets what it
+// gets alone, in the
 // scenes above (direct spheres of each kind, planes, one-leaf world meshes, transformed
 // top-level plates), from points on and near the surfaces and in open space.
 TEST_CASE_TEMPLATE("SceneGeometry: shadow rays tested several at a time get what each gets alone", Real, float, double) {
@@ -616,9 +616,9 @@ TEST_CASE_TEMPLATE("SceneGeometry: shadow rays tested several at a time get what
     }
 }
 
-// Camera rays tested several at a time (SceneGeometry::intersect_each: the world meshes' leaves
-// and the direct spheres with a ray in each lane): every ray of a batch, of any length up to a
-// row's 16, gets the hit intersect gives it alone, to the bit (t, object, primitive,
+// Camera rays tested several at a time (a batch through SceneGeometry::intersect: the world
+// meshes' leaves and the direct spheres with a ray in each lane): every ray of a batch, of any
+// length up to a row's 16, gets the hit it gets alone, to the bit (t, object, primitive,
 // barycentrics, the lowered t_max), under each culling rule, in the scenes above: direct
 // spheres of every map (plain, translated, ellipsoids), a floor of two triangles and planes
 // side by side; merged flat quads, a smooth tent and transformed plates through intersect's
@@ -635,7 +635,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: camera rays tested several at a time get what
         if (kind == 4) world.planes.clear();
         const Geometry geometry(world);
         // Side by side where the top level holds spheres alone; the transformed plates of
-        // tiny_meshes keep intersect's own path, which intersect_each must then give too.
+        // tiny_meshes keep the one-ray path, which the batch must then give too.
         REQUIRE((geometry.route() == prism::BatchRoute::leaf_lanes) == (kind != 3));
 
         std::mt19937 random(23);
@@ -681,7 +681,8 @@ TEST_CASE_TEMPLATE("SceneGeometry: camera rays tested several at a time get what
                 if (batch % 7 == 0) rays[std::size_t(i)].t_min = Real(1e-3);
             }
             std::array<prism::Ray<Real>, 16> each = rays;
-            // The same rays as shadow rays, side by side (occluded_side_by_side).
+            const std::array<prism::Ray<Real>, 16> rays_before = rays;
+            // The same rays as shadow rays, as one batch.
             std::uint32_t blocked = 0;
             for (int i = 0; i < count; ++i)
                 if (prism::blocked(geometry, rays[std::size_t(i)])) blocked |= std::uint32_t(1) << i;
@@ -707,6 +708,31 @@ TEST_CASE_TEMPLATE("SceneGeometry: camera rays tested several at a time get what
                 ++kinds_hit[kind_hit];
             }
             CHECK(found < (std::uint32_t(1) << count));
+            // The same batch with a random active mask, gaps included: the active rays get what
+            // they get alone, the others are left as they were (t_max and hit untouched).
+            const std::uint32_t mask = std::uint32_t(random()) & ((std::uint32_t(1) << count) - 1);
+            std::array<prism::Ray<Real>, 16> masked = rays_before;
+            std::array<prism::Hit<Real>, 16> masked_hits;
+            for (auto& hit : masked_hits) hit.object = 12345;
+            const std::uint32_t masked_found = geometry.intersect(prism::RayBatch<Real>{masked.data(), count, mask, culling}, masked_hits.data());
+            CHECK(masked_found == (found & mask));
+            std::uint32_t masked_blocked_expected = 0;
+            for (int i = 0; i < count; ++i) {
+                CAPTURE(i);
+                const std::size_t k = std::size_t(i);
+                if (!((mask >> i) & 1)) {
+                    CHECK(same_bits(masked[k].t_max, rays_before[k].t_max));
+                    CHECK(masked_hits[k].object == 12345);
+                    continue;
+                }
+                if (prism::blocked(geometry, rays_before[k])) masked_blocked_expected |= std::uint32_t(1) << i;
+                CHECK(same_bits(masked[k].t_max, rays[k].t_max));
+                if (!((found >> i) & 1)) continue;
+                CHECK(same_bits(masked_hits[k].t, hits[k].t));
+                CHECK(masked_hits[k].object == hits[k].object);
+                CHECK(masked_hits[k].primitive == hits[k].primitive);
+            }
+            CHECK(geometry.occluded(prism::RayBatch<Real>{rays_before.data(), count, mask}) == masked_blocked_expected);
         }
         // Hits and misses both common, and every kind of surface met.
         CHECK(hits_found > rays_tested / 5);

@@ -66,7 +66,7 @@ struct SceneIndex<Real, Policy, MotionBlur>::WorldSpaceRays {
 // and occluded's own leaves_box test, ray by ray.
 template <Scalar Real, class Policy, bool MotionBlur>
     requires AccelerationPolicy<Policy, Real>
-std::uint32_t SceneIndex<Real, Policy, MotionBlur>::lanes_reaching(const typename Mesh::Leaf& leaf, const Ray<Real>* rays, int n,
+inline std::uint32_t SceneIndex<Real, Policy, MotionBlur>::lanes_reaching(const typename Mesh::Leaf& leaf, const Ray<Real>* rays, int n,
                                                            std::uint32_t skip) {
     std::uint32_t lanes = 0;
     for (int i = 0; i < n; ++i)
@@ -78,7 +78,7 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::lanes_reaching(const typenam
 template <Scalar Real, class Policy, bool MotionBlur>
     requires AccelerationPolicy<Policy, Real>
 template <class Packets>
-typename Packets::LanePack SceneIndex<Real, Policy, MotionBlur>::lanes_t_max(const Ray<Real>* rays, int n) {
+inline typename Packets::LanePack SceneIndex<Real, Policy, MotionBlur>::lanes_t_max(const Ray<Real>* rays, int n) {
     alignas(64) Real limits[Packets::ray_lanes];
     for (int i = 0; i < Packets::ray_lanes; ++i) limits[i] = rays[i < n ? i : 0].t_max;
     return Packets::LanePack::load(limits);
