@@ -170,7 +170,7 @@ private:
     template <BackfaceCulling Culling>
     [[gnu::always_inline]] bool closest_one(Ray<Real>& ray, Hit<Real>& hit) const {
         if (direct_form_) {
-            const bool found = !world_meshes_.empty() && (two_leaves_ ? intersect_world_leaves<Culling, true>(ray, hit)
+            const bool found = !world_meshes_.empty() && (several_leaves_ ? intersect_world_leaves<Culling, true>(ray, hit)
                                                                        : intersect_world_leaves<Culling, false>(ray, hit));
             return closest_direct<Culling>(ray, hit, found);
         }
@@ -316,7 +316,7 @@ private:
     // simple_transform, two rotated meshes and a sphere: 1.04 of the CPU time with them).
     bool intersection_batches() const {
         if constexpr (Mesh::packed) {
-            if constexpr (Mesh::Packets::tests_ray_lanes) return direct_form_ && !two_leaves_ && !direct_.has_meshes();
+            if constexpr (Mesh::Packets::tests_ray_lanes) return direct_form_ && !several_leaves_ && !direct_.has_meshes();
         }
         return false;
     }
@@ -468,32 +468,32 @@ private:
     // TraversalRay: each index's leaf directly (TriangleMesh::intersect_leaf), then the spheres
     // and planes. The TraversalRay (three divisions, broadcast) and the root's box test were
     // a fifth of hw1 simple_reflectance's profile (a two-triangle floor and one sphere). An
-    // index whose root holds two leaves is tested leaf by leaf too (intersect_root_leaves:
+    // index whose root holds up to four leaves is tested leaf by leaf too (intersect_root_leaves:
     // hw1 ocornellbox's ten wall triangles, where the TraversalRay, the root's test made twice
-    // and the traversal were 15% of the profile). The
+    // and the traversal were 15% of the profile; the hw7 Cornell boxes' three). The
     // hits are the index's: traversal of a single leaf tests that leaf, in the same slot order
     // with the same t_max; only a ray whose box test the index would fail is now tested too,
     // and the conservative box (Ize's widened exit) fails only rays that miss the triangles.
     // A scene with a top-level index keeps it, and its TraversalRay, but its world-space
-    // indices of one or two leaves are still tested leaf by leaf (intersect_indexed): hw2
+    // indices of a few leaves are still tested leaf by leaf (intersect_indexed): hw2
     // horse_instanced's two-triangle floor had cost each camera ray a root test and a
     // traversal of their own, 7% of its instructions.
     void choose_direct_world_meshes() {
         for (WorldMeshes& group : world_meshes_) group.leaves = index_of(group).root_leaves();
         if (!top_objects_.empty() && !direct_.chosen()) return;
-        bool two_leaves = false;
+        bool several_leaves = false;
         for (const WorldMeshes& group : world_meshes_) {
             if (!group.leaves) return;
-            two_leaves |= group.leaves->count == 2;
+            several_leaves |= group.leaves->count > 1;
         }
         direct_form_ = true;
-        two_leaves_ = two_leaves;
+        several_leaves_ = several_leaves;
     }
 
     // The world-space meshes' leaves for intersect's direct path: hit or not, and hit filled as
     // intersect's loop over the indices fills it.
-    // TwoLeaves: some index has two (two_leaves_); without it, the one-leaf code alone.
-    template <BackfaceCulling Culling, bool TwoLeaves>
+    // Several: some index has more than one (several_leaves_); without, the one-leaf code alone.
+    template <BackfaceCulling Culling, bool Several>
     bool intersect_world_leaves(Ray<Real>& ray, Hit<Real>& hit) const {
         if constexpr (Mesh::packed) {
             std::optional<TriangleRay> triangle_ray;  // made for the first leaf the ray may reach
@@ -501,8 +501,8 @@ private:
             for (const WorldMeshes& group : world_meshes_) {
                 const Mesh& index = index_of(group);
                 const bool cull = culls_back_faces(Culling);
-                const bool group_hit = cull ? intersect_root_leaves<true, TwoLeaves>(index, *group.leaves, ray, triangle_ray, hit)
-                                            : intersect_root_leaves<false, TwoLeaves>(index, *group.leaves, ray, triangle_ray, hit);
+                const bool group_hit = cull ? intersect_root_leaves<true, Several>(index, *group.leaves, ray, triangle_ray, hit)
+                                            : intersect_root_leaves<false, Several>(index, *group.leaves, ray, triangle_ray, hit);
                 if (group_hit) {
                     if (group.index) group.attribute(index.source_triangle(hit.primitive), hit);
                     else hit.object = group.objects[0];
@@ -515,60 +515,64 @@ private:
         }
     }
 
-    // One index's closest hit from its root's one or two leaves, the hit its traversal finds.
-    // Two leaves are each tested up to the ray's own t_max, without their boxes' order: a leaf's
-    // test keeps its closest candidate at or below t_max (later slots winning ties), so under
-    // the lower t_max the nearer leaf's hit leaves the farther one, it is the same candidate
-    // where it passes, and the strictly nearer of the two hits is what either order of visits
-    // ends with. Only equal distances depend on the order (the later leaf wins), and the
-    // traversal orders leaves by their boxes' entry distances: those rays (an edge shared by
-    // the two leaves) are handed to the traversal itself, from the state before either leaf.
-    template <bool CullBackfaces, bool TwoLeaves>
+    // One index's closest hit from its root's few leaves, the hit its traversal finds. Each leaf
+    // is tested up to the ray's own t_max, without the boxes' order: a leaf's test keeps its
+    // closest candidate at or below t_max (later slots winning ties), so under a lower t_max a
+    // nearer leaf's hit leaves a farther one, it is the same candidate where it passes, and the
+    // strictly nearest of the leaves' hits is what any order of visits ends with. Only equal
+    // nearest distances depend on the order (the later leaf wins), and the traversal orders
+    // leaves by their boxes' entry distances: those rays (an edge shared by two leaves) are
+    // handed to the traversal itself, from the state before any leaf.
+    template <bool CullBackfaces, bool Several>
     [[gnu::always_inline]] static bool intersect_root_leaves(const Mesh& index, const typename Mesh::RootLeaves& leaves,
                                                              Ray<Real>& ray, std::optional<TriangleRay>& triangle_ray,
                                                              Hit<Real>& hit) {
         const auto& first = leaves.leaf[0];
-        if (!TwoLeaves || leaves.count == 1) {
+        if (!Several || leaves.count == 1) {
             if (leaves_box(first.box, ray)) return false;
             if (!triangle_ray) triangle_ray.emplace(ray);
             return index.template intersect_leaf<CullBackfaces>(ray, *triangle_ray, first, ray.t_max, hit);
         }
-        const auto& second = leaves.leaf[1];
-        const bool may_first = !leaves_box(first.box, ray), may_second = !leaves_box(second.box, ray);
-        if (!may_first && !may_second) return false;
-        if (!triangle_ray) triangle_ray.emplace(ray);
-        Real t_first = ray.t_max, t_second = ray.t_max;
-        Hit<Real> hit_first = hit, hit_second = hit;
-        const bool found_first =
-            may_first && index.template intersect_leaf<CullBackfaces>(ray, *triangle_ray, first, t_first, hit_first);
-        const bool found_second =
-            may_second && index.template intersect_leaf<CullBackfaces>(ray, *triangle_ray, second, t_second, hit_second);
-        if (found_first && found_second && t_first == t_second)
-            return index.template intersect<CullBackfaces>(ray, TraversalRay(ray), *triangle_ray, ray.t_max, hit);
-        if (found_second && (!found_first || t_second < t_first)) {
-            ray.t_max = t_second;
-            hit = hit_second;
-            return true;
+        Real nearest = ray.t_max;
+        Hit<Real> nearest_hit;
+        bool found = false, tied = false;
+        for (int i = 0; i < leaves.count; ++i) {
+            const auto& leaf = leaves.leaf[std::size_t(i)];
+            if (leaves_box(leaf.box, ray)) continue;
+            if (!triangle_ray) triangle_ray.emplace(ray);
+            Real t = ray.t_max;
+            Hit<Real> candidate = hit;
+            if (!index.template intersect_leaf<CullBackfaces>(ray, *triangle_ray, leaf, t, candidate)) continue;
+            if (found && t == nearest) {
+                tied = true;
+                continue;
+            }
+            if (found && !(t < nearest)) continue;
+            nearest = t;
+            nearest_hit = candidate;
+            found = true;
+            tied = false;
         }
-        if (!found_first) return false;
-        ray.t_max = t_first;
-        hit = hit_first;
+        if (tied) return index.template intersect<CullBackfaces>(ray, TraversalRay(ray), *triangle_ray, ray.t_max, hit);
+        if (!found) return false;
+        ray.t_max = nearest;
+        hit = nearest_hit;
         return true;
     }
 
     // occluded for direct_form_: the world meshes' leaves, then the direct top level and planes.
     [[gnu::always_inline]] bool occluded_without_index(const Ray<Real>& ray) const {
-        return (!world_meshes_.empty() && (two_leaves_ ? occluded_world_leaves<true>(ray) : occluded_world_leaves<false>(ray))) ||
+        return (!world_meshes_.empty() && (several_leaves_ ? occluded_world_leaves<true>(ray) : occluded_world_leaves<false>(ray))) ||
                occluded_direct(ray);
     }
 
-    template <bool TwoLeaves>
+    template <bool Several>
     bool occluded_world_leaves(const Ray<Real>& ray) const {
         if constexpr (Mesh::packed) {
             std::optional<TriangleRay> triangle_ray;
             for (const WorldMeshes& group : world_meshes_) {
                 const Mesh& index = index_of(group);
-                for (int i = 0; i < (TwoLeaves ? group.leaves->count : 1); ++i) {
+                for (int i = 0; i < (Several ? group.leaves->count : 1); ++i) {
                     const auto& leaf = group.leaves->leaf[std::size_t(i)];
                     if (leaves_box(leaf.box, ray)) continue;
                     if (!triangle_ray) triangle_ray.emplace(ray);
@@ -586,7 +590,7 @@ private:
         std::optional<Mesh> index;
         std::vector<std::uint32_t> objects;         // per part, its object (Hit::object)
         std::vector<std::uint32_t> first_triangle;  // per part, the number of its first triangle
-        std::optional<typename Mesh::RootLeaves> leaves;  // the index's leaves, when its root has only one or two (direct_form_)
+        std::optional<typename Mesh::RootLeaves> leaves;  // the index's leaves, when its root has only a few
 
         // The hit on triangle `number` of the index (hit.primitive holds the index's slot)
         // as a hit on its own mesh: its object, its triangle there (the file's order, in which
@@ -608,7 +612,7 @@ private:
     std::vector<std::uint32_t> top_objects_;  // the top level's primitives: the objects not merged
     Direct direct_;  // the top level without its index, where chosen
     bool direct_form_ = false;  // no TraversalRay: the top level direct, the world meshes' leaves too
-    bool two_leaves_ = false;   // some world-space index of the direct form has a root of two leaves
+    bool several_leaves_ = false;  // some world-space index of the direct form has a root of several leaves
     PlaneSet<Real> planes_;
     Aabb<Real> bounds_;
     Index top_;

@@ -107,11 +107,13 @@ public:
         return std::nullopt;
     }
 
-    // The leaves of an index whose root holds nothing but leaves, at most two of them (a wide
-    // BVH over 9 to 2N triangles, e.g. hw1 ocornellbox's ten wall triangles, which the build
-    // splits in two), in the root's slot order; none for a larger index.
+    // The leaves of an index whose root holds nothing but leaves, at most max_root_leaves of
+    // them (a wide BVH over 9 to 4N triangles: hw1 ocornellbox's ten wall triangles, which the
+    // build splits in two; the hw7 Cornell boxes' walls and light, in three), in the root's slot
+    // order; none for a larger index.
+    static constexpr int max_root_leaves = 4;
     struct RootLeaves {
-        std::array<Leaf, 2> leaf{};
+        std::array<Leaf, max_root_leaves> leaf{};
         int count = 0;
     };
     std::optional<RootLeaves> root_leaves() const {
@@ -121,7 +123,7 @@ public:
             RootLeaves leaves;
             for (int i = 0; i < Index::width; ++i) {
                 if (nodes[0].count(i) == 0) continue;
-                if (leaves.count == 2) return std::nullopt;
+                if (leaves.count == max_root_leaves) return std::nullopt;
                 Leaf& leaf = leaves.leaf[std::size_t(leaves.count++)];
                 leaf.first = nodes[0].index(i);
                 leaf.count = nodes[0].count(i);
