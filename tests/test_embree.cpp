@@ -194,6 +194,37 @@ TEST_CASE("--accelerator embree renders every hw1 and hw2 course scene as prism'
     CHECK(scenes > 40);
 }
 
+// The path tracer through the same query seam: hw7's path-traced Cornell boxes (every
+// RendererParams combination, object lights, glass) render through Embree as through prism's own
+// index. Both draw the same numbers for the same pixel, so the images differ only where a hit
+// differs (ties at shared edges): not a noisy comparison of two estimates.
+TEST_CASE("--accelerator embree path traces hw7's Cornell boxes as prism's own accelerator does") {
+    const auto rows = prism_test::read_manifest();
+    if (rows.empty()) {
+        MESSAGE("skipped: no course manifest");
+        return;
+    }
+    int cameras = 0;
+    for (const auto& row : rows) {
+        if (row.topic != "hw7_pathtracing_objlights" || row.path.find("cornellbox_jaroslav_path_") == std::string::npos) continue;
+        const scene::Scene world = prism::io::load_scene(course_folder / row.path);
+        prism::RenderOptions options;
+        options.resolution_scale = 0.125;
+        options.max_samples = 2;
+        std::ostringstream log;
+        const auto own = prism::render_scene(world, options, log);
+        options.accelerator = prism::AcceleratorChoice::embree;
+        const auto embree = prism::render_scene(world, options, log);
+        REQUIRE(own.size() == embree.size());
+        for (std::size_t c = 0; c < own.size(); ++c) {
+            INFO(row.path << " camera " << c);
+            CHECK(prism::share_off_by_more_than(prism::to_8bit(own[c].image), prism::to_8bit(embree[c].image), 1) <= 0.01);
+            ++cameras;
+        }
+    }
+    CHECK(cameras == 16);  // path_diffuse's and path_glass's eight cameras each
+}
+
 TEST_CASE("--accelerator embree culls back faces as prism's own accelerator does") {
     scene::Scene world = mixed_scene();
     prism::RenderOptions options;

@@ -681,7 +681,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: camera rays tested several at a time get what
                 if (batch % 7 == 0) rays[std::size_t(i)].t_min = Real(1e-3);
             }
             std::array<prism::Ray<Real>, 16> each = rays;
-            const std::array<prism::Ray<Real>, 16> rays_before = rays;
+            std::array<prism::Ray<Real>, 16> rays_before = rays;  // as the rays were before any query
             // The same rays as shadow rays, as one batch.
             std::uint32_t blocked = 0;
             for (int i = 0; i < count; ++i)

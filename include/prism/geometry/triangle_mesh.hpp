@@ -250,8 +250,11 @@ public:
     // filled (WideBvhTree::traverse_closest_lanes; the leaf's packet test of each ray). Returns
     // the rays hit. A ray's closest hit is intersect's wherever it is the one nearest hit, and
     // `tied` gets the rays whose hit may depend on the order the leaves were visited in: a
-    // leaf's hit at the t_max it was given (the packet test takes a later tie, and with
-    // DoubleRefine two hits rounding to one float t are such a tie). The caller traces those
+    // leaf's hit at the t_max it was given (the packet test takes a later tie). With a Storage
+    // wider than Real (DoubleRefine), two hits rounding to one Real t are such a tie too, but
+    // the later one is refused where its Storage t lies above the rounded t_max (a vertex
+    // shared by two leaves' triangles): so each leaf is tested up to the next Real above
+    // t_max, where such a hit is taken and the ray counted tied. The caller traces tied rays
     // again with intersect, from what they had before.
     template <bool CullBackfaces>
     std::uint32_t intersect_lanes(const Ray<Real>* rays, const TraversalRay* traversal, const TriangleRay* triangle,
@@ -265,9 +268,12 @@ public:
                 for (; testing != 0; testing &= testing - 1) {
                     const int i = std::countr_zero(testing);
                     const Real before = t_max[i];
+                    if constexpr (!std::is_same_v<Storage, Real>) t_max[i] = std::nextafter(before, infinity<Real>);
                     if (!packets_.template intersect<CullBackfaces>(triangle[i].packed_ray, rays[i].direction, first, count,
-                                                                    rays[i].t_min, t_max[i], hits[i]))
+                                                                    rays[i].t_min, t_max[i], hits[i])) {
+                        t_max[i] = before;
                         continue;
+                    }
                     hit |= std::uint32_t(1) << i;
                     if (!(t_max[i] < before)) tied |= std::uint32_t(1) << i;
                 }
