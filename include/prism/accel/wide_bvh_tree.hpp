@@ -1,13 +1,9 @@
 // A wide BVH: every node has up to N children (4 or 8) whose boxes are stored SoA, so one SIMD
-// slab test (simd/pack.hpp) decides them all. Built by collapsing the binned-SAH binary tree
-// (accel/bvh_tree.hpp) with the surface area heuristic: for every binary subtree, the cheapest
-// way to spread it over 1..N child slots is found bottom up (dynamic programming, as Ylitie,
-// Karras and Laine 2017 collapse into their compressed wide BVH), and each wide node takes the
-// cheapest spread of its binary node's two subtrees over all N slots. Opening the largest-area
-// child until N children are found (Wald, Benthin, Boulos 2008) had left 4.3 children per node
-// on the tiny-triangle dragon; this collapse gives 7.4 and 8-10% faster rays (bench/RESULTS.md).
-// Traversal is nearest first for the closest hit and in stack order for any hit. Like BvhTree it
-// holds no primitives: a leaf hands its range of primitive_indices to a callback.
+// slab test (simd/pack.hpp) decides them all (the node: accel/wide_bvh_node.hpp). Built by
+// collapsing the binned-SAH binary tree (accel/bvh_tree.hpp) with the surface area heuristic
+// (accel/wide_bvh_collapse.hpp). Traversal is nearest first for the closest hit and in stack
+// order for any hit; several rays at once take accel/wide_bvh_lanes.hpp. Like BvhTree it holds
+// no primitives: a leaf hands its range of primitive_indices to a callback.
 //
 // Leaves are sized for N-wide triangle packets: a leaf is a binary subtree of at most 2N
 // primitives (one or two packets; max_leaf_size when that is below N), and every leaf's range
@@ -17,11 +13,9 @@
 #pragma once
 
 #include <prism/accel/bvh_tree.hpp>
-#include <prism/memory/huge_page_allocator.hpp>
+#include <prism/accel/wide_bvh_node.hpp>
 #include <prism/simd/pack.hpp>
 #include <prism/simd/prefetch.hpp>
-
-#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <array>
@@ -30,7 +24,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
-#include <stdexcept>
 #include <type_traits>
 #include <vector>
 
@@ -54,49 +47,6 @@ inline thread_local TraversalStats traversal_stats;
 #endif
 
 namespace prism {
-
-template <Scalar Real, int N>
-struct alignas(64) WideBvhNode {
-    // bounds[axis][child] is the low plane, bounds[3 + axis][child] the high one. An empty
-    // child slot is the empty box (low +inf, high -inf): entered at +inf and left at -inf
-    // whatever the direction's sign, it is missed even by a ray with t_max = inf.
-    Real bounds[6][N];
-    // Each child in one word, as Embree's tagged node references: one load and one register
-    // per child on the way down, and a test of its lowest bit tells a leaf. An inner child is
-    // its node's byte offset in the tree's node array (a multiple of the node's size, so its
-    // lowest bit is 0), which traversal adds to the array's address as it is, with no shift on
-    // the way to the next node's load; a leaf is first << 32 | count << 1 | 1, first its first
-    // slot in primitive_indices and count its primitives (any count: a leaf of primitives that
-    // cannot be split, such as many equal boxes, may hold hundreds). An empty slot holds 0.
-    // Eight 64-bit words fill the fourth line of an 8-wide float node, which the two arrays
-    // of 32-bit child indices and counts filled before: the node stays 256 bytes.
-    std::uint64_t child[N];
-
-    // A node of N empty slots, filled child by child by a builder.
-    static WideBvhNode empty() {
-        WideBvhNode node;
-        for (int row = 0; row < 6; ++row)
-            for (Real& plane : node.bounds[row]) plane = row < 3 ? infinity<Real> : -infinity<Real>;
-        for (int i = 0; i < N; ++i) node.child[i] = 0;
-        return node;
-    }
-
-    static constexpr bool is_leaf_word(std::uint64_t word) { return (word & 1) != 0; }
-    static constexpr std::uint32_t leaf_first(std::uint64_t word) { return std::uint32_t(word >> 32); }
-    static constexpr std::uint32_t leaf_count(std::uint64_t word) { return std::uint32_t(word) >> 1; }
-    // Leaf: its primitive count; inner child or empty slot: 0.
-    std::uint32_t count(int i) const { return is_leaf_word(child[i]) ? leaf_count(child[i]) : 0; }
-    // Inner child: its node's index; leaf: its first slot in primitive_indices.
-    std::uint32_t index(int i) const {
-        return is_leaf_word(child[i]) ? leaf_first(child[i]) : std::uint32_t(child[i] / sizeof(WideBvhNode));
-    }
-    void set_inner(int i, std::uint32_t node) { child[i] = std::uint64_t(node) * sizeof(WideBvhNode); }
-    void set_leaf(int i, std::uint32_t first, std::uint32_t primitives) {
-        if (primitives == 0 || primitives > (UINT32_MAX >> 1)) throw std::length_error("WideBvhTree: a leaf of 0 or 2^31 primitives");
-        child[i] = std::uint64_t(first) << 32 | std::uint64_t(primitives) << 1 | 1;
-    }
-};
-static_assert(sizeof(WideBvhNode<float, 8>) == 256, "an 8-wide float node is four cache lines");
 
 template <Scalar Real, int N>
 class WideBvhTree {
@@ -231,202 +181,22 @@ public:
         return traverse<true>(ray, t_min, t_max, leaf, touch);
     }
 
-    // Any hit for several rays at once (bit i of `lanes` for ray i, i < 32: a row's shadow rays
-    // to one light), each ray's answer traverse_any's: a ray is tested at a node only if it
-    // entered that node's box, with its own slab set-up (`slabs[i]`) and the node test
-    // traverse_any makes, so each ray reaches exactly the leaves it would reach alone. Only the
-    // order of the visits differs, which an any-hit answer does not depend on.
-    // leaf(first, count, lanes) tests the leaf's primitives for the rays of `lanes` and returns
-    // the blocked ones; the answer is every blocked ray.
-    // The rays' node tests are independent of each other: where one ray waits on each node's
-    // test before it can load the next node, the tests of the rays that reach a node overlap.
+    // Several rays at once, each ray's answer the one it gets alone (accel/wide_bvh_lanes.hpp):
+    // any hits (a row's shadow rays to one light), closest hits (a pixel's camera rays), and
+    // which of the rays enter each child of a node.
     template <class Leaf>
     std::uint32_t traverse_any_lanes(const TraversalRay* slabs, const Real* t_min, const Real* t_max, std::uint32_t lanes,
-                                     Leaf&& leaf) const {
-        if (nodes_.empty() || lanes == 0) return 0;
-        struct LaneEntry {
-            std::uint64_t child;
-            std::uint32_t lanes;
-        };
-        std::array<LaneEntry, stack_size> stack;
-        alignas(64) Real far_limit[32];
-        for (std::uint32_t rest = lanes; rest != 0; rest &= rest - 1) {
-            const int i = std::countr_zero(rest);
-            far_limit[i] = t_max[i] * far_scale;
-        }
-        int size = 0;
-        std::uint32_t blocked = 0;
-        std::uint64_t current = 0;
-        std::uint32_t current_lanes = lanes;
-        for (;;) {
-            const Node& node = node_at(current);
-            const std::array<std::uint32_t, N> entering =
-                children_entered(node, slabs, t_min, far_limit, current_lanes, [](int, const auto&, const Pack&) {});
-            // The leaves first, as traverse_any tests them: a shadow ray ends at its first blocker.
-            std::uint32_t inner = 0;
-            for (int c = 0; c < N; ++c) {
-                if (entering[std::size_t(c)] == 0) continue;
-                const std::uint64_t word = node.child[c];
-                if (!Node::is_leaf_word(word)) {
-                    inner |= std::uint32_t(1) << c;
-                    continue;
-                }
-                const std::uint32_t testing = entering[std::size_t(c)] & ~blocked;
-                if (testing == 0) continue;
-                PRISM_COUNT_LEAF(Node::leaf_count(word), N);
-                blocked |= leaf(Node::leaf_first(word), Node::leaf_count(word), testing) & testing;
-            }
-            if (blocked == lanes) return blocked;
-            bool descend = false;
-            if (inner != 0) {
-                const int last = 31 - std::countl_zero(inner);
-                inner &= ~(std::uint32_t(1) << last);
-                for (; inner != 0; inner &= inner - 1) {
-                    const int c = std::countr_zero(inner);
-                    stack[size++] = LaneEntry{node.child[c], entering[std::size_t(c)]};
-                    simd::prefetch(node_at(node.child[c]));
-                }
-                const std::uint32_t next = entering[std::size_t(last)] & ~blocked;
-                if (next != 0) {
-                    current = node.child[last];
-                    current_lanes = next;
-                    descend = true;
-                }
-            }
-            while (!descend && size > 0) {
-                const LaneEntry& entry = stack[--size];
-                const std::uint32_t next = entry.lanes & ~blocked;
-                if (next == 0) continue;
-                current = entry.child;
-                current_lanes = next;
-                descend = true;
-            }
-            if (!descend) return blocked;
-        }
-    }
-
-    // Closest hits for several rays at once (bit i of `lanes` for ray i, i < 32: a pixel's
-    // camera rays), each ray tested at a node only if it entered that node's box within its own
-    // current t_max, with its own slab set-up and traverse's node test, so each ray reaches
-    // every leaf that could hold a hit nearer than the one it has. The leaves are visited in
-    // one order for all the rays (nearest first by the nearest entry among them), not each
-    // ray's own: the closest hit is the same wherever it is unique, and the caller decides what
-    // a tie means (TriangleMesh::intersect_lanes).
-    // leaf(first, count, lanes) tests the leaf's primitives for the rays of `lanes`, lowers
-    // t_max[i] for each ray it hits and returns those rays; the answer is every ray hit.
+                                     Leaf&& leaf) const;
     template <class Leaf>
     std::uint32_t traverse_closest_lanes(const TraversalRay* slabs, const Real* t_min, Real* t_max, std::uint32_t lanes,
-                                         Leaf&& leaf) const {
-        if (nodes_.empty() || lanes == 0) return 0;
-        struct LaneEntry {
-            std::uint64_t child;
-            std::uint32_t lanes;
-            Real nearest;  // the nearest entry of its rays into its box
-        };
-        std::array<LaneEntry, stack_size> stack;
-        alignas(64) Real far_limit[32];
-        Real farthest = 0;  // the largest far_limit of the rays: an entry beyond it is no ray's
-        for (std::uint32_t rest = lanes; rest != 0; rest &= rest - 1) {
-            const int i = std::countr_zero(rest);
-            far_limit[i] = t_max[i] * far_scale;
-            farthest = std::max(farthest, far_limit[i]);
-        }
-        const auto after_hits = [&](std::uint32_t hit) {
-            if (hit == 0) return;
-            for (std::uint32_t rest = hit; rest != 0; rest &= rest - 1) {
-                const int i = std::countr_zero(rest);
-                far_limit[i] = t_max[i] * far_scale;
-            }
-            farthest = 0;
-            for (std::uint32_t rest = lanes; rest != 0; rest &= rest - 1) farthest = std::max(farthest, far_limit[std::countr_zero(rest)]);
-        };
-        int size = 0;
-        std::uint32_t found = 0;
-        std::uint64_t current = 0;
-        std::uint32_t current_lanes = lanes;
-        for (;;) {
-            const Node& node = node_at(current);
-            // Per child, the rays that enter it and the nearest entry among them.
-            Pack nearest = Pack::broadcast(infinity<Real>);
-            const std::array<std::uint32_t, N> entering = children_entered(
-                node, slabs, t_min, far_limit, current_lanes,
-                [&](int, const auto& entered, const Pack& entry) { nearest = select(entered, simd::min_keep(entry, nearest), nearest); });
-            // The entered children pushed farthest first, so that the nearest is popped first.
-            alignas(64) Real distances[N];
-            nearest.store(distances);
-            std::uint32_t children = 0;
-            for (int c = 0; c < N; ++c)
-                if (entering[std::size_t(c)] != 0) children |= std::uint32_t(1) << c;
-            const int first_pushed = size;
-            for (std::uint32_t rest = children; rest != 0; rest &= rest - 1) {
-                const int c = std::countr_zero(rest);
-                int place = first_pushed;
-                while (place < size && stack[std::size_t(place)].nearest >= distances[c]) ++place;
-                for (int k = size; k > place; --k) stack[std::size_t(k)] = stack[std::size_t(k - 1)];
-                stack[std::size_t(place)] = LaneEntry{node.child[c], entering[std::size_t(c)], distances[c]};
-                ++size;
-            }
-            // Pop until an inner node to descend into; leaves on the way are tested at once.
-            bool descend = false;
-            while (size > 0) {
-                const LaneEntry entry = stack[std::size_t(--size)];
-                if (entry.nearest > farthest) continue;
-                if (!Node::is_leaf_word(entry.child)) {
-                    current = entry.child;
-                    current_lanes = entry.lanes;
-                    descend = true;
-                    break;
-                }
-                PRISM_COUNT_LEAF(Node::leaf_count(entry.child), N);
-                const std::uint32_t hit =
-                    leaf(Node::leaf_first(entry.child), Node::leaf_count(entry.child), entry.lanes) & entry.lanes;
-                found |= hit;
-                after_hits(hit);
-            }
-            if (!descend) return found;
-        }
-    }
-
-    // Which rays of `lanes` enter each child of `node` (bit i of entering[c] for ray i), each
-    // by its own node test (enter, with its own slab set-up, t_min and far_limit); `each(i,
-    // mask, entry)` sees each ray's test. The rays' hit masks are the rows of a bit matrix (byte
-    // i % 8 of rows[i / 8] for ray i), transposed eight by eight into the children's ray masks,
-    // with no branch on any ray's hits (a loop over each ray's hit bits mispredicted at about
-    // every node).
+                                         Leaf&& leaf) const;
     template <class Each>
     [[gnu::always_inline]] static std::array<std::uint32_t, N> children_entered(const WideBvhNode<Real, N>& node,
                                                                                  const TraversalRay* slabs, const Real* t_min,
                                                                                  const Real* far_limit, std::uint32_t lanes,
-                                                                                 Each&& each) {
-        std::array<std::uint64_t, 4> rows{};
-        for (std::uint32_t rest = lanes; rest != 0; rest &= rest - 1) {
-            const int i = std::countr_zero(rest);
-            Pack entry;
-            const auto entered = enter(node, slabs[i], t_min[i], far_limit[i], entry);
-            each(i, entered, entry);
-            rows[std::size_t(i >> 3)] |= std::uint64_t(entered.bits()) << (8 * (i & 7));
-        }
-        std::array<std::uint32_t, N> entering{};
-        for (int group = 0; group < 4; ++group) {
-            if (rows[std::size_t(group)] == 0) continue;
-            const std::uint64_t columns = transpose_bits(rows[std::size_t(group)]);
-            for (int c = 0; c < N; ++c)
-                entering[std::size_t(c)] |= std::uint32_t((columns >> (8 * c)) & 0xff) << (8 * group);
-        }
-        return entering;
-    }
-
-    // The 8x8 bit matrix whose row i is byte i of x, transposed (bit c of byte i becomes bit i
-    // of byte c): three exchanges of 2x2 blocks of growing size (Warren, Hacker's Delight 7-3).
-    static constexpr std::uint64_t transpose_bits(std::uint64_t x) {
-        std::uint64_t t = (x ^ (x >> 7)) & 0x00AA00AA00AA00AAull;
-        x ^= t ^ (t << 7);
-        t = (x ^ (x >> 14)) & 0x0000CCCC0000CCCCull;
-        x ^= t ^ (t << 14);
-        t = (x ^ (x >> 28)) & 0x00000000F0F0F0F0ull;
-        x ^= t ^ (t << 28);
-        return x;
-    }
+                                                                                 Each&& each);
+    // The 8x8 bit matrix whose row i is byte i of x, transposed.
+    static constexpr std::uint64_t transpose_bits(std::uint64_t x);
 
     // Whether the ray enters any of the root's children within [t_min, t_max]: the first test
     // traversal makes, and the one a two-level scene makes before it prepares the triangle
@@ -623,136 +393,8 @@ private:
         return std::uint32_t(nodes_.size() - 1);
     }
 
-    struct Collapser {
-        const BvhTree<Real>& binary;
-        WideBvhTree& tree;
-        std::uint32_t max_leaf_size;
-        struct Range {
-            std::uint32_t begin, end;
-        };
-        // Written whole before they are read: not cleared, and in huge pages (accel/bvh_tree.hpp).
-        HugePageVector<Range> ranges;  // each binary node's contiguous range of primitive_indices
-        // The cheapest way to hold each binary subtree in k child slots, k = 1..N, in the surface
-        // area heuristic's units: a node test costs its box's half area, a leaf its box's half
-        // area per packet (a packet test and a node test take about as long: both are one SIMD
-        // pass over N lanes, and costing packets at 0.5 or 2 times a node made the same trees
-        // within 1% of nodes).
-        HugePageVector<double> cost;           // [node * N + k - 1]
-        HugePageVector<std::uint8_t> split;    // slots given to the left child; 0: one slot holds it all
-        HugePageVector<std::uint8_t> as_leaf;  // the one-slot form is a leaf
-        std::uint32_t leaf_limit = 0;
-
-        // measure and plan write only their own subtree's entries, so the two subtrees of a
-        // node near the root go to two tasks: the same tables, made on every thread there is.
-        // In trees of at least parallel_from primitives, nodes fewer than parallel_depth levels
-        // from the root fork (up to 2^parallel_depth tasks); smaller trees take one thread.
-        static constexpr int parallel_depth = 6;
-        static constexpr std::size_t parallel_from = 16384;
-        bool forks(int depth) const { return depth < parallel_depth && binary.primitive_indices().size() >= parallel_from; }
-
-        Range measure(std::uint32_t i, int depth = 0) {
-            const BvhNode<Real>& node = binary.nodes()[i];
-            if (node.is_leaf()) return ranges[i] = {node.index, node.index + node.count};
-            Range left, right;
-            if (forks(depth)) {
-                tbb::parallel_invoke([&] { left = measure(node.index, depth + 1); },
-                                     [&] { right = measure(node.index + 1, depth + 1); });
-            } else {
-                left = measure(node.index, depth + 1);
-                right = measure(node.index + 1, depth + 1);
-            }
-            return ranges[i] = {left.begin, right.end};
-        }
-
-        double& slots_cost(std::uint32_t i, int k) { return cost[std::size_t(i) * N + std::size_t(k - 1)]; }
-
-        void plan(std::uint32_t i, int depth = 0) {
-            const BvhNode<Real>& node = binary.nodes()[i];
-            const double area = double(node.bounds.half_area());
-            const std::uint32_t count = ranges[i].end - ranges[i].begin;
-            const double leaf = area * double((count + N - 1) / N);
-            if (node.is_leaf()) {
-                as_leaf[i] = 1;
-                for (int k = 1; k <= N; ++k) slots_cost(i, k) = leaf;
-                return;
-            }
-            const std::uint32_t left = node.index, right = node.index + 1;
-            if (forks(depth)) {
-                tbb::parallel_invoke([&] { plan(left, depth + 1); }, [&] { plan(right, depth + 1); });
-            } else {
-                plan(left, depth + 1);
-                plan(right, depth + 1);
-            }
-            // best[k]: the children's subtrees spread over k >= 2 slots.
-            std::array<double, N + 1> best{};
-            for (int k = 2; k <= N; ++k) {
-                best[k] = infinity<double>;
-                for (int j = 1; j < k; ++j) {
-                    const double spread = slots_cost(left, j) + slots_cost(right, k - j);
-                    if (spread < best[k]) {
-                        best[k] = spread;
-                        split[std::size_t(i) * N + std::size_t(k - 1)] = std::uint8_t(j);
-                    }
-                }
-            }
-            const double inner = area + best[N];
-            const bool leaf_allowed = count <= leaf_limit;
-            as_leaf[i] = leaf_allowed && leaf <= inner;
-            const double one_slot = as_leaf[i] ? leaf : inner;
-            slots_cost(i, 1) = one_slot;
-            for (int k = 2; k <= N; ++k) {
-                if (one_slot <= best[k]) {
-                    slots_cost(i, k) = one_slot;
-                    split[std::size_t(i) * N + std::size_t(k - 1)] = 0;
-                } else {
-                    slots_cost(i, k) = best[k];
-                }
-            }
-        }
-
-        void gather(std::uint32_t i, int k, std::array<std::uint32_t, N>& children, int& child_count) {
-            const std::uint8_t j = k == 1 ? 0 : split[std::size_t(i) * N + std::size_t(k - 1)];
-            if (binary.nodes()[i].is_leaf() || j == 0) {
-                children[child_count++] = i;
-                return;
-            }
-            gather(binary.nodes()[i].index, j, children, child_count);
-            gather(binary.nodes()[i].index + 1, k - j, children, child_count);
-        }
-
-        bool becomes_leaf(std::uint32_t i) const { return as_leaf[i] != 0; }
-
-        // Makes the wide node for binary inner node i; returns its index.
-        std::uint32_t collapse(std::uint32_t i) {
-            std::array<std::uint32_t, N> children{};
-            int child_count = 0;
-            const std::uint8_t j = split[std::size_t(i) * N + std::size_t(N - 1)];
-            gather(binary.nodes()[i].index, j, children, child_count);
-            gather(binary.nodes()[i].index + 1, N - j, children, child_count);
-            const std::uint32_t wide = tree.new_node();
-            for (int c = 0; c < child_count; ++c) fill_child(wide, c, children[c]);
-            return wide;
-        }
-
-        void fill_child(std::uint32_t wide, int slot, std::uint32_t i) {
-            const Aabb<Real>& box = binary.nodes()[i].bounds;
-            for (int axis = 0; axis < 3; ++axis) {
-                tree.nodes_[wide].bounds[axis][slot] = box.min[axis];
-                tree.nodes_[wide].bounds[3 + axis][slot] = box.max[axis];
-            }
-            if (becomes_leaf(i)) {
-                auto& indices = tree.primitive_indices_;
-                const auto& binary_indices = binary.primitive_indices();
-                const Range range = ranges[i];
-                tree.nodes_[wide].set_leaf(slot, std::uint32_t(indices.size()), range.end - range.begin);
-                indices.insert(indices.end(), binary_indices.begin() + range.begin, binary_indices.begin() + range.end);
-                while (indices.size() % N != 0) indices.push_back(indices.back());
-            } else {
-                const std::uint32_t node = collapse(i);  // may reallocate nodes_: index again
-                tree.nodes_[wide].set_inner(slot, node);
-            }
-        }
-    };
+    // The binary tree's collapse into wide nodes (accel/wide_bvh_collapse.hpp).
+    struct Collapser;
 
     std::vector<WideBvhNode<Real, N>> nodes_;
     std::vector<std::uint32_t> primitive_indices_;
@@ -760,3 +402,6 @@ private:
 };
 
 }  // namespace prism
+
+#include <prism/accel/wide_bvh_collapse.hpp>
+#include <prism/accel/wide_bvh_lanes.hpp>

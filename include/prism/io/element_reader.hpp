@@ -1,6 +1,6 @@
 // The scene interpreter's vocabulary for reading one element: faults that name the file and the
 // element (LoadError), numbers in every spelling the course's files use, ids, keywords, and the
-// list of elements left unread. Shared by scene_loader.hpp and texture_loader.hpp.
+// list of elements left unread. Shared by scene_loader.hpp and its section readers (*_loader.hpp).
 #pragma once
 
 #include <prism/io/element.hpp>
