@@ -1,5 +1,5 @@
 # The packages prism::prism depends on, found the same way by the build tree and by an installed
-# prismConfig.cmake. All come from Debian packages (see README); stb has no CMake config there,
+# prismConfig.cmake. All come from Debian packages (see docs/architecture.md); stb has no CMake config there,
 # so its library and headers are found by hand and wrapped in an imported target.
 include(CMakeFindDependencyMacro)
 find_dependency(glm CONFIG)

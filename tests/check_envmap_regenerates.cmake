@@ -1,4 +1,4 @@
-# Runs prism-envmap with the arguments README documents for scenes/environment/sky_*.exr and
+# Runs prism-envmap with the arguments docs/lights-and-tonemapping.md documents for scenes/environment/sky_*.exr and
 # checks that the output is byte-identical to the committed file.
 execute_process(
   COMMAND ${ENVMAP} --layout ${LAYOUT} --width ${WIDTH} --sun-direction 0.6,0.5,-0.6 --sun-angle 6

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Fuzzes one of prism's readers with libFuzzer (clang, AddressSanitizer + UndefinedBehaviorSanitizer).
 #   bash tools/fuzz.sh TARGET SECONDS [extra libFuzzer flags]
+#   bash tools/fuzz.sh build          (builds the four harnesses at once, on every core, and exits)
 # TARGET: xml | json (scene loaders, to the scene description), ply (PLY reader), image (stb and
 # tinyexr behind decode_image). Builds what it needs in build-fuzz/, seeds the corpus
 # build-fuzz/corpus/TARGET from ../shared (and the repository's own scenes) the first time, runs
@@ -9,20 +10,21 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-if [[ $# -lt 2 ]]; then
-  echo "usage: bash tools/fuzz.sh xml|json|ply|image SECONDS [libFuzzer flags]" >&2
+if [[ $# -lt 2 && ${1:-} != build ]]; then
+  echo "usage: bash tools/fuzz.sh xml|json|ply|image SECONDS [libFuzzer flags] | bash tools/fuzz.sh build" >&2
   exit 2
 fi
-target=$1 seconds=$2 max_len=65536
-shift 2
+target=$1 seconds=${2:-0} max_len=65536
+shift $(($# < 2 ? $# : 2))
 case "$target" in
+  build) binary="fuzz_scene_xml fuzz_scene_json fuzz_ply fuzz_image" ;;
   xml) binary=fuzz_scene_xml patterns=("*.xml") ;;
   json) binary=fuzz_scene_json patterns=("*.json") ;;
   ply) binary=fuzz_ply patterns=("*.ply") ;;
   image) binary=fuzz_image max_len=16384 patterns=("*.png" "*.jpg" "*.jpeg" "*.hdr" "*.exr" "*.bmp" "*.tga" "*.ppm") ;;
   *) echo "fuzz.sh: unknown target '$target' (xml, json, ply or image)" >&2; exit 2 ;;
 esac
-if ! [[ "$seconds" =~ ^[0-9]+$ ]] || [[ "$seconds" -lt 1 ]]; then
+if [[ $target != build ]] && { ! [[ "$seconds" =~ ^[0-9]+$ ]] || [[ "$seconds" -lt 1 ]]; }; then
   echo "fuzz.sh: SECONDS must be a positive whole number" >&2
   exit 2
 fi
@@ -37,7 +39,9 @@ if [[ ! -f $build/CMakeCache.txt ]]; then
   cmake -S . -B $build -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14 \
         -DPRISM_BUILD_FUZZERS=ON -DPRISM_BUILD_EXAMPLES=OFF -DPRISM_BUILD_TESTS=OFF >/dev/null
 fi
-cmake --build $build --target "$binary" -j "$(nproc)" >/dev/null
+# shellcheck disable=SC2086 # "build" names the four harnesses
+cmake --build $build --target $binary -j "$(nproc)" >/dev/null
+[[ $target == build ]] && exit 0
 
 # The seed corpus: the course's files of the target's kind, up to 64 KiB each (libFuzzer reads
 # only the first -max_len bytes of a larger one: 64 KiB, 16 KiB for images, whose decoding under

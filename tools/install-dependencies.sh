@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages prism builds with, if any is missing. Needs root (or sudo).
 # --with-embree adds Embree 3 (the benchmarks' comparison); --with-chart adds what
-# tools/chart.sh needs to turn its SVG into a PNG (rsvg-convert and a font).
+# tools/chart.sh needs to turn its SVG into a PNG (rsvg-convert and a font); --with-browser adds
+# Debian's Chromium, in which the test report/opens_in_chromium loads prism-suite's HTML report
+# (skipped without it); --with-fuzzers adds clang 14 and its libFuzzer runtime (tools/fuzz.sh).
 set -euo pipefail
 packages=(build-essential cmake pkg-config libglm-dev libtinyexr-dev libstb-dev nlohmann-json3-dev
           libpugixml-dev libtbb-dev doctest-dev libbenchmark-dev)
@@ -9,7 +11,9 @@ for option in "$@"; do
   case "$option" in
     --with-embree) packages+=(libembree-dev) ;;
     --with-chart) packages+=(librsvg2-bin fonts-dejavu-core) ;;
-    *) echo "install-dependencies.sh: unknown option $option (expected --with-embree or --with-chart)" >&2; exit 2 ;;
+    --with-browser) packages+=(chromium) ;;
+    --with-fuzzers) packages+=(clang-14 libclang-rt-14-dev zlib1g-dev) ;;
+    *) echo "install-dependencies.sh: unknown option $option (expected --with-embree, --with-chart, --with-browser or --with-fuzzers)" >&2; exit 2 ;;
   esac
 done
 missing=()

@@ -2,11 +2,12 @@
 # Builds the unit tests (and, given a regex beyond them, the prism renderer) with AddressSanitizer
 # and UndefinedBehaviorSanitizer (-DPRISM_SANITIZE=ON, in build-sanitize/) and runs the unit tests
 # there (ctest -R ^unit/): what CI runs sanitized. Any report fails the run. -O1 keeps the build and the run short on 2 cores.
-# Two choices keep CI within its 30 minutes (README, "What CI adds"): ASan's use-after-scope
-# check is off (it tripled the compile time of the template-heavy test files: 350 s against
-# 114 s of CPU for test_merged_meshes.cpp), and Embree is left out (its library is not
-# instrumented; prism's adapter is tested in the Release suite), so unit/test_embree reports
-# itself skipped here.
+# Two choices keep CI within its budget (docs/hostile-input.md, "Sanitizers"): ASan's
+# use-after-scope check is off (it tripled the compile time of the template-heavy test files:
+# 350 s against 114 s of CPU for test_merged_meshes.cpp), and Embree is left out (its library is
+# not instrumented; prism's adapter is tested in the Release suite), so unit/test_embree reports
+# itself skipped here. The test files compile in unity groups, as in the Release build
+# (tests/CMakeLists.txt, PRISM_UNITY_TESTS).
 #   bash tools/sanitize.sh [ctest regex, default ^unit/]
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -2,6 +2,7 @@
 // compares each camera's image with its expected image and prints one table row per image,
 // so a renderer is checked against the course in one command and one exit status.
 #include "../common/command_line.hpp"
+#include "report.hpp"
 
 #include <prism/image/compare.hpp>
 #include <prism/image/image_io.hpp>
@@ -67,6 +68,11 @@ options:
                        judged (default high); images with weaker references are listed as
                        `info` and never fail (none: report every PSNR, judge nothing)
   --output-dir DIR     write every render to DIR/TOPIC/SCENE-FORMAT/IMAGE_NAME
+  --report DIR         also write DIR/report.html, one self-contained page (no network) with
+                       the images beside it in DIR/images/: a summary and the PSNR
+                       distribution, then each image's render, reference and a heat map of
+                       their difference as compared, sortable by PSNR and time, filterable by
+                       topic. Open it in any browser; DIR is created, and must be writable
   --threads N          worker threads (default: all hardware threads)
   --precision P        float | double-refine | double: override the precision chosen from
                        the scene
@@ -95,8 +101,9 @@ an output not written).
 
 The last line is the summary `N passed, M failed[, K skipped]` (FAIL and ERROR count as
 failed; info, rendered and skipped as skipped).
-exit status: 0 when nothing failed, 1 when something failed, 2 for usage errors (unknown
-option, a manifest or folder that does not exist, a selection that matches no scene).
+exit status: 0 when nothing failed, 1 when something failed (or the report could not be
+written at the end), 2 for usage errors (unknown option, a manifest or folder that does not
+exist, a selection that matches no scene, a --report folder that cannot be created or written).
 )";
 
 std::string lowercase(std::string text) {
@@ -130,6 +137,7 @@ struct Arguments {
     double threshold = 40.0;
     int required_rank = 3;
     std::optional<fs::path> output_dir;
+    std::optional<fs::path> report_dir;  // --report
     bool verbose = false;
     bool hdr = false;  // --hdr
     prism::RenderOptions options;
@@ -168,6 +176,8 @@ Arguments parse_arguments(int argc, char** argv) {
             else command_line.usage_error("--require must be high, medium, any or none");
         } else if (arg == "--output-dir") {
             arguments.output_dir = fs::path(value());
+        } else if (arg == "--report") {
+            arguments.report_dir = fs::path(value());
         } else if (arg == "--verbose") {
             arguments.verbose = true;
         } else if (arg == "--hdr") {
@@ -333,9 +343,7 @@ std::optional<Reference> find_reference(const Job& job, const fs::path& image_na
 // ---------------------------------------------------------------------------------------------
 // The table: rows are printed as they are finished, so a long run shows its results as it goes.
 
-struct Row {
-    std::string topic, scene, format, image = "-", size = "-", seconds = "-", psnr = "-", off = "-", status, note;
-};
+using prism::suite::Row;
 
 struct Widths {
     std::size_t topic = 5, scene = 5, image = 5;
@@ -376,8 +384,11 @@ void add_to_tally(const Row& row, Tally& tally) {
 
 // ---------------------------------------------------------------------------------------------
 
+// Compares one image with its reference; `compared`, when given, receives both images as the
+// comparison saw them (the report shows them so).
 Row compare_image(const Arguments& arguments, const prism::scene::Camera& camera,
-                  const prism::CameraImage& rendered, const Reference& reference, Row row) {
+                  const prism::CameraImage& rendered, const Reference& reference, Row row,
+                  std::optional<prism::suite::ComparedImages>* compared) {
     const bool judged = reference.rank >= arguments.required_rank;
     const auto weak = [&] { return "reference is [" + reference.confidence + "], below --require"; };
     try {
@@ -411,6 +422,7 @@ Row compare_image(const Arguments& arguments, const prism::scene::Camera& camera
             expected_bytes =
                 prism::to_8bit(prism::downsample_box(displayed, rendered.image.width, rendered.image.height));
         }
+        if (compared) *compared = prism::suite::ComparedImages{rendered.image.width, rendered.image.height, actual, expected_bytes};
         const double psnr = prism::psnr(actual, expected_bytes);
         row.psnr = std::isinf(psnr) ? "inf" : fixed(psnr, 2);
         row.off = fixed(100.0 * prism::share_off_by_more_than(actual, expected_bytes, 8), 2);
@@ -429,14 +441,15 @@ Row compare_image(const Arguments& arguments, const prism::scene::Camera& camera
 
 // Loads, renders and compares one scene; prints its rows and adds them to the tally.
 void run_job(const Arguments& arguments, const Job& job, std::size_t index, std::size_t job_count,
-             const Widths& widths, Tally& tally) {
+             const Widths& widths, Tally& tally, prism::suite::Report* report) {
     Row scene_row;
     scene_row.topic = job.topic;
     scene_row.scene = job.scene;
     scene_row.format = job.format;
-    const auto emit = [&](const Row& row) {
+    const auto emit = [&](const Row& row, const std::optional<prism::suite::ComparedImages>& images = std::nullopt) {
         print_row(row, widths);
         add_to_tally(row, tally);
+        if (report) report->add(row, images);
     };
     std::ostringstream log;
     try {
@@ -469,6 +482,7 @@ void run_job(const Arguments& arguments, const Job& job, std::size_t index, std:
                 prism::CameraImage shown = rendered;
                 if (output.tonemap) shown.image = prism::tone_map(rendered.image, camera.tonemaps[*output.tonemap]);
                 Row row = scene_row;
+                std::optional<prism::suite::ComparedImages> compared;
                 row.image = image_name.string();
                 row.size = std::to_string(shown.image.width) + "x" + std::to_string(shown.image.height);
                 row.seconds = fixed(rendered.seconds, 2);
@@ -480,7 +494,7 @@ void run_job(const Arguments& arguments, const Job& job, std::size_t index, std:
                     for (std::size_t r = 0; r < job.references.size(); ++r)
                         if (job.references[r].path == reference->path || same_stem(job.references[r].path, image_name))
                             reference_used[r] = true;
-                    row = compare_image(arguments, camera, shown, *reference, row);
+                    row = compare_image(arguments, camera, shown, *reference, row, report ? &compared : nullptr);
                 } else {
                     row.status = "rendered";
                 }
@@ -500,7 +514,10 @@ void run_job(const Arguments& arguments, const Job& job, std::size_t index, std:
                 }
                 if (!unsupported.empty())
                     row.note += std::string(row.note.empty() ? "" : "; ") + "not rendered yet: " + unsupported;
-                emit(row);
+                // A row compared with nothing still shows its render, clamped to 8 bits.
+                if (report && !compared)
+                    compared = prism::suite::ComparedImages{shown.image.width, shown.image.height, prism::to_8bit(shown.image), {}};
+                emit(row, compared);
             }
         }
         for (std::size_t r = 0; r < job.references.size(); ++r)
@@ -557,17 +574,42 @@ int main(int argc, char** argv) {
                          : arguments.required_rank == 3 ? "[high]"
                          : arguments.required_rank == 2 ? "[high] and [medium]"
                                                         : "all";
-    std::cout << "prism-suite: " << jobs.size() << (jobs.size() == 1 ? " scene" : " scenes") << " from "
-              << arguments.input.string() << "; PASS: PSNR >= " << arguments.threshold << " dB against " << judged
-              << " references; scale " << arguments.options.resolution_scale << "\n\n";
+    std::ostringstream heading;
+    heading << "prism-suite: " << jobs.size() << (jobs.size() == 1 ? " scene" : " scenes") << " from "
+            << arguments.input.string() << "; PASS: PSNR >= " << arguments.threshold << " dB against " << judged
+            << " references; scale " << arguments.options.resolution_scale;
+
+    // The report's folder is checked before anything renders: a long run must not end unable to
+    // write its page.
+    std::optional<prism::suite::Report> report;
+    if (arguments.report_dir) {
+        try {
+            report.emplace(*arguments.report_dir);
+        } catch (const std::exception& report_error) {
+            std::cerr << "prism-suite: " << report_error.what() << '\n';
+            return 2;
+        }
+    }
+
+    std::cout << heading.str() << "\n\n";
     print_row({"topic", "scene", "format", "image", "size", "seconds", "PSNR(dB)", "off>8(%)", "status", "note"},
               widths);
 
     Tally tally;
-    for (std::size_t i = 0; i < jobs.size(); ++i) run_job(arguments, jobs[i], i, jobs.size(), widths, tally);
+    for (std::size_t i = 0; i < jobs.size(); ++i)
+        run_job(arguments, jobs[i], i, jobs.size(), widths, tally, report ? &*report : nullptr);
 
     std::cout << '\n' << tally.passed << " passed, " << tally.failed << " failed";
     if (tally.skipped > 0) std::cout << ", " << tally.skipped << " skipped";
     std::cout << '\n';
+    if (report) {
+        try {
+            report->write(heading.str());
+            std::cout << "report: " << report->page().string() << '\n';
+        } catch (const std::exception& report_error) {
+            std::cerr << "prism-suite: " << report_error.what() << '\n';
+            return 1;
+        }
+    }
     return tally.failed > 0 ? 1 : 0;
 }

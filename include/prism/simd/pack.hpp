@@ -8,7 +8,7 @@
 // Both give bit-identical results: every operation is one IEEE operation per lane, and prism
 // builds with -ffp-contract=off so no compiler fuses a multiply and an add (a fused edge
 // function would no longer be the exact negation of its neighbour's, and the watertight test
-// would leak). See README "SIMD" for the measurements behind the choice.
+// would leak). See docs/accelerators.md, "The SIMD layer", for the measurements behind the choice.
 #pragma once
 
 #include <array>
