@@ -151,8 +151,14 @@ public:
     // in each lane (intersection_batches) takes them so; a scene with an index (no direct form)
     // takes up to index_lanes rays through it together (the nodes' tests of several rays then
     // overlap instead of each waiting on the one before); elsewhere (roots of two leaves or
-    // top-level meshes tested directly, no packets) the rays go one by one.
-    BatchRoute route() const {
+    // top-level meshes tested directly, no packets) the rays go one by one. So do batches of
+    // fewer than side_by_side_rays active rays, as Embree's hybrid traversal drops to single
+    // rays when few stay active: a point's shadow rays to its two lights cost hw2
+    // horse_and_glass_mug 1.11 times its time through the index together (lane set-up and
+    // masks for two rays going different ways), and the ray tracer had sent them one by one.
+    static constexpr int side_by_side_rays = 4;
+    BatchRoute route(int active_rays = RayBatch<Real>::max_rays) const {
+        if (active_rays < side_by_side_rays) return BatchRoute::ray_by_ray;
         if constexpr (Mesh::packed) {
             if (intersection_batches()) return BatchRoute::leaf_lanes;
             if (!direct_form_) return BatchRoute::index_lanes;
@@ -189,7 +195,7 @@ private:
     }
     template <BackfaceCulling Culling>
     std::uint32_t closest_gathered(const RayBatch<Real>& batch, Hit<Real>* hits) const {
-        const BatchRoute way = route();
+        const BatchRoute way = route(std::popcount(batch.active));
         if (way == BatchRoute::ray_by_ray) {
             std::uint32_t found = 0;
             for (std::uint32_t lanes = batch.active; lanes != 0; lanes &= lanes - 1) {
@@ -217,7 +223,7 @@ private:
     }
     // Several rays, as route() says: side by side, or ray by ray over the active mask.
     std::uint32_t occluded_many(const RayBatch<Real>& batch) const {
-        const BatchRoute way = route();
+        const BatchRoute way = route(std::popcount(batch.active));
         if (way == BatchRoute::ray_by_ray) {
             std::uint32_t blocked = 0;
             for (std::uint32_t lanes = batch.active; lanes != 0; lanes &= lanes - 1) {
