@@ -14,6 +14,7 @@
 
 #include <prism/accel/bvh_tree.hpp>
 #include <prism/accel/wide_bvh_node.hpp>
+#include <prism/memory/huge_page_allocator.hpp>
 #include <prism/simd/pack.hpp>
 #include <prism/simd/prefetch.hpp>
 
@@ -104,16 +105,16 @@ public:
     // starting at multiples of N and padded with repeats): bench/intersect_bench.cpp runs this
     // kernel on trees built by Embree's builder, to tell the tree's share of the time from the
     // kernel's.
-    static WideBvhTree from_layout(std::vector<WideBvhNode<Real, N>> nodes, std::vector<std::uint32_t> primitive_indices,
+    static WideBvhTree from_layout(std::span<const WideBvhNode<Real, N>> nodes, std::vector<std::uint32_t> primitive_indices,
                                    Aabb<Real> bounds) {
         WideBvhTree tree;
-        tree.nodes_ = std::move(nodes);
+        tree.nodes_.assign(nodes.begin(), nodes.end());
         tree.primitive_indices_ = std::move(primitive_indices);
         tree.bounds_ = bounds;
         return tree;
     }
 
-    const std::vector<WideBvhNode<Real, N>>& nodes() const { return nodes_; }
+    std::span<const WideBvhNode<Real, N>> nodes() const { return nodes_; }
     // Leaf ranges padded to multiples of N (see the top of this file).
     const std::vector<std::uint32_t>& primitive_indices() const { return primitive_indices_; }
     Aabb<Real> bounds() const { return bounds_; }
@@ -396,7 +397,11 @@ private:
     // The binary tree's collapse into wide nodes (accel/wide_bvh_collapse.hpp).
     struct Collapser;
 
-    std::vector<WideBvhNode<Real, N>> nodes_;
+    // In transparent huge pages where they fill one (memory/huge_page_allocator.hpp), as the
+    // leaves' packets are: a large mesh's traversal reads nodes all over the array, and in 4 kB
+    // pages the dragon's per-ray time against Embree (which asks for huge pages itself) swung
+    // between runs (bench/RESULTS.md, "Per ray against Embree").
+    HugePageVector<WideBvhNode<Real, N>> nodes_;
     std::vector<std::uint32_t> primitive_indices_;
     Aabb<Real> bounds_;
 };

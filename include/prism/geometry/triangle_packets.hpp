@@ -11,6 +11,7 @@
 #include <prism/geometry/double_refine.hpp>
 #include <prism/geometry/hit.hpp>
 #include <prism/geometry/watertight.hpp>
+#include <prism/memory/huge_page_allocator.hpp>
 #include <prism/parallel/for_each_run.hpp>
 #include <prism/simd/opaque.hpp>
 #include <prism/simd/pack.hpp>
@@ -457,7 +458,9 @@ private:
         return lanes;
     }
 
-    std::vector<Packet> packets_;
+    // In transparent huge pages where they fill one (memory/huge_page_allocator.hpp; the
+    // constructor writes every slot), as the nodes are (WideBvhTree::nodes_).
+    HugePageVector<Packet> packets_;
     std::vector<Vec3<Real>> normals_;  // per slot, read only when culling back faces
 };
 
