@@ -1392,7 +1392,7 @@ void check_tree_from_layout(const std::vector<prism::Aabb<Real>>& boxes, const s
     using Tree = prism::WideBvhTree<Real, N>;
     const Tree built = Tree::build(boxes);
     const Tree adopted = Tree::from_layout(built.nodes(), built.primitive_indices(), built.bounds());
-    std::vector<prism::WideBvhNode<Real, N>> nodes = built.nodes();
+    std::vector<prism::WideBvhNode<Real, N>> nodes(built.nodes().begin(), built.nodes().end());
     for (auto& node : nodes) {
         for (int i = 0; i < N / 2; ++i) {
             for (auto& row : node.bounds) std::swap(row[i], row[N - 1 - i]);
