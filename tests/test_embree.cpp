@@ -151,6 +151,23 @@ TEST_CASE_TEMPLATE("Embree finds the hits prism's own BVH finds: hw2 horse_insta
     CHECK(agreement.disagreements <= allowed_disagreement * double(agreement.rays));
 }
 
+// Each camera's share of 8-bit pixels off by more than one between the scene rendered through
+// the CLI's own path (render_scene) with prism's accelerator and with Embree's.
+std::vector<double> shares_off_through_embree(const scene::Scene& world, double scale, int samples) {
+    prism::RenderOptions options;
+    options.resolution_scale = scale;
+    options.max_samples = samples;
+    std::ostringstream log;
+    const auto own = prism::render_scene(world, options, log);
+    options.accelerator = prism::AcceleratorChoice::embree;
+    const auto embree = prism::render_scene(world, options, log);
+    REQUIRE(own.size() == embree.size());
+    std::vector<double> shares;
+    for (std::size_t c = 0; c < own.size(); ++c)
+        shares.push_back(prism::share_off_by_more_than(prism::to_8bit(own[c].image), prism::to_8bit(embree[c].image), 1));
+    return shares;
+}
+
 // Every hw1/hw2 scene of the manifest that loads, through the CLI's own path (render_scene) with
 // each accelerator, at a quarter of the resolution and at most one sample a pixel.
 TEST_CASE("--accelerator embree renders every hw1 and hw2 course scene as prism's own accelerator does") {
@@ -169,17 +186,9 @@ TEST_CASE("--accelerator embree renders every hw1 and hw2 course scene as prism'
         } catch (const std::exception&) {
             continue;  // refused scenes (hw2 instanced_bunny) are the loader tests' business
         }
-        prism::RenderOptions options;
-        options.resolution_scale = 0.25;
-        options.max_samples = 1;
-        std::ostringstream log;
-        const auto own = prism::render_scene(world, options, log);
-        options.accelerator = prism::AcceleratorChoice::embree;
-        const auto embree = prism::render_scene(world, options, log);
-        REQUIRE(own.size() == embree.size());
-        for (std::size_t c = 0; c < own.size(); ++c) {
-            const double share =
-                prism::share_off_by_more_than(prism::to_8bit(own[c].image), prism::to_8bit(embree[c].image), 1);
+        const std::vector<double> shares = shares_off_through_embree(world, 0.25, 1);
+        for (std::size_t c = 0; c < shares.size(); ++c) {
+            const double share = shares[c];
             INFO(row.path << " camera " << c);
             // Rounding ties only: pixel centres exactly on an edge shared by two triangles,
             // which the two traversals may give to either. The course's Cornell boxes are
@@ -208,17 +217,10 @@ TEST_CASE("--accelerator embree path traces hw7's Cornell boxes as prism's own a
     for (const auto& row : rows) {
         if (row.topic != "hw7_pathtracing_objlights" || row.path.find("cornellbox_jaroslav_path_") == std::string::npos) continue;
         const scene::Scene world = prism::io::load_scene(course_folder / row.path);
-        prism::RenderOptions options;
-        options.resolution_scale = 0.125;
-        options.max_samples = 2;
-        std::ostringstream log;
-        const auto own = prism::render_scene(world, options, log);
-        options.accelerator = prism::AcceleratorChoice::embree;
-        const auto embree = prism::render_scene(world, options, log);
-        REQUIRE(own.size() == embree.size());
-        for (std::size_t c = 0; c < own.size(); ++c) {
+        const std::vector<double> shares = shares_off_through_embree(world, 0.125, 2);
+        for (std::size_t c = 0; c < shares.size(); ++c) {
             INFO(row.path << " camera " << c);
-            CHECK(prism::share_off_by_more_than(prism::to_8bit(own[c].image), prism::to_8bit(embree[c].image), 1) <= 0.01);
+            CHECK(shares[c] <= 0.01);
             ++cameras;
         }
     }
