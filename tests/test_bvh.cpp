@@ -928,7 +928,9 @@ TEST_CASE_TEMPLATE("SceneGeometry: the hit interval is the same for triangles, s
     plane_scene.planes.push_back({"wall", 0, {0, 0, -2}, {0, 0, 1}, glm::dmat4(1.0)});
     const std::array<std::pair<std::string, const scene::Scene*>, 3> cases{
         {{"triangle", &triangle_scene}, {"sphere", &sphere_scene}, {"plane", &plane_scene}}};
-    for (const auto& [shape, world] : cases) {
+    for (const auto& shape_case : cases) {
+        const std::string& shape = shape_case.first;
+        const scene::Scene* const world = shape_case.second;
         CAPTURE(shape);
         for_each_bvh<Real>([&]<class Geometry>() {
         const Geometry geometry(*world);

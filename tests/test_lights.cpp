@@ -109,7 +109,8 @@ TEST_CASE_TEMPLATE("SpotLight: inside, across and outside the cone, with inverse
 }
 
 TEST_CASE_TEMPLATE("SpotLight: no ring at the falloff edge or the coverage edge", Real, float, double) {
-    for (const auto& [coverage, falloff] : {std::pair{60.0, 40.0}, std::pair{10.0, 8.0}, std::pair{120.0, 30.0}}) {
+    for (const auto& angles : {std::pair{60.0, 40.0}, std::pair{10.0, 8.0}, std::pair{120.0, 30.0}}) {
+        const double coverage = angles.first, falloff = angles.second;
         CAPTURE(coverage);
         CAPTURE(falloff);
         const auto spot = prism::SpotLight<Real>::from_description(downward_spot(coverage, falloff));

@@ -310,7 +310,9 @@ TEST_CASE("read_ply: the extremes of every integer type, signed and unsigned kep
                                         {"uint", 0, 4294967295.0},
                                         {"uint32", 0, 4294967295.0}}};
     for (Format format : all_formats) {
-        for (const auto& [type, low, high] : all) {
+        for (const auto& limits : all) {
+            const char* const type = limits.type;
+            const double low = limits.low, high = limits.high;
             CAPTURE(format_name(format));
             CAPTURE(type);
             const std::string name(type);
@@ -437,7 +439,9 @@ TEST_CASE("read_ply: texture coordinate names, and normals only when nx ny nz ar
     const std::array<std::array<const char*, 2>, 4> uv_names{
         {{"u", "v"}, {"s", "t"}, {"texture_u", "texture_v"}, {"texture_s", "texture_t"}}};
     for (Format format : all_formats) {
-        for (const auto& [u_name, v_name] : uv_names) {
+        for (const auto& names : uv_names) {
+            const char* const u_name = names[0];
+            const char* const v_name = names[1];
             CAPTURE(format_name(format));
             CAPTURE(u_name);
             Body body(format);

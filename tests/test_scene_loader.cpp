@@ -349,7 +349,9 @@ TEST_CASE("scenes given in both XML and JSON describe the same scene") {
         if (row.unresolved.empty() && find_known_broken(row.path) == nullptr)
             by_scene[row.topic + "/" + row.scene][row.format] = row.path;
     std::size_t pairs = 0;
-    for (const auto& [name, formats] : by_scene) {
+    for (const auto& scene_files : by_scene) {
+        const std::string& name = scene_files.first;
+        const auto& formats = scene_files.second;
         if (formats.count("xml") == 0 || formats.count("json") == 0) continue;
         ++pairs;
         INFO(name << ": " << formats.at("xml") << " against " << formats.at("json"));

@@ -1,7 +1,8 @@
 // simd/pack.hpp: max_keep and min_keep, whose exact IEEE behaviour the wide BVH's slab test relies on
 // (a NaN distance constrains nothing), and sqrt, negation and >=, which the direct spheres'
 // test on several rays relies on for the scalar sphere test's bits. A faster form must keep
-// these bits.
+// these bits. And select, lane by lane at every width the kernels use (clang 14 with libstdc++'s
+// AVX-512 masks got it wrong: simd/pack.hpp).
 #include <prism/simd/pack.hpp>
 
 #include <doctest/doctest.h>
@@ -73,7 +74,34 @@ void check_sqrt_negation_compare() {
     }
 }
 
+template <class T, int N>
+void check_select() {
+    using Pack = prism::simd::Pack<T, N>;
+    alignas(64) T a[N], b[N], chosen[N];
+    for (int pattern = 0; pattern < 8; ++pattern) {
+        for (int i = 0; i < N; ++i) {
+            a[i] = T(i + 1);
+            b[i] = ((i * 7 + pattern) % 3 == 0) ? T(-(i + 1)) : T(100 + i);  // a < b where b is large
+        }
+        const Pack pa = Pack::load(a), pb = Pack::load(b);
+        select(pa < pb, pa, pb).store(chosen);
+        for (int i = 0; i < N; ++i) {
+            CAPTURE(N);
+            CAPTURE(i);
+            CHECK(same_bits(chosen[i], a[i] < b[i] ? a[i] : b[i]));
+        }
+    }
+}
+
 }  // namespace
+
+TEST_CASE_TEMPLATE("select is mask ? a : b in every lane, at every width", T, float, double) {
+    check_select<T, 2>();
+    check_select<T, 4>();
+    check_select<T, 8>();
+    check_select<T, 16>();
+    check_select<T, 32>();
+}
 
 TEST_CASE_TEMPLATE("sqrt is std::sqrt's, -p and p >= q each lane's, to the bit", T, float, double) {
     check_sqrt_negation_compare<T, 4>();
@@ -84,4 +112,6 @@ TEST_CASE_TEMPLATE("max_keep and min_keep are a > b ? a : b and a < b ? a : b, N
                    float, double) {
     check_keep<T, 4>();
     check_keep<T, 8>();
+    check_keep<T, 16>();
+    check_keep<T, 32>();
 }

@@ -204,8 +204,10 @@ TEST_CASE_TEMPLATE("SceneGeometry: tiny world-space meshes tested without their 
     for (const auto& mesh : direct_world.meshes) meshes.push_back({&mesh, mesh.transform});
     meshes.push_back({&direct_world.meshes[3], direct_world.mesh_instances[0].transform});
     const auto target = [&](int i) {
-        const auto& [mesh_pointer, transform] = meshes[std::size_t(i) % meshes.size()];
-        const scene::Mesh& mesh = *mesh_pointer;
+        // Not a structured binding: clang 14 cannot capture one in the lambda below.
+        const auto& placed = meshes[std::size_t(i) % meshes.size()];
+        const scene::Mesh& mesh = *placed.first;
+        const glm::dmat4& transform = placed.second;
         const auto& face = mesh.triangles[std::size_t(i / 3) % mesh.triangles.size()];
         const double a = 0.5 * (1 + uniform(random)), b = 0.5 * (1 + uniform(random));
         const auto world = [&](std::uint32_t v) { return glm::dvec3(transform * glm::dvec4(mesh.positions[v], 1.0)); };

@@ -4,6 +4,7 @@
 // callback, so one tree serves triangles of a mesh and instances of a scene alike.
 #pragma once
 
+#include <prism/math/force_inline.hpp>
 #include <prism/geometry/aabb.hpp>
 #include <prism/math/floating_point.hpp>
 #include <prism/memory/huge_page_allocator.hpp>
@@ -276,14 +277,14 @@ private:
         Aabb<Real> aabb() const { return {{min[0], min[1], min[2]}, {max[0], max[1], max[2]}}; }
         // Each lane's (min + max) * 0.5, as Aabb::centroid computes it, so bins and partitions
         // see the same centroids.
-        [[gnu::always_inline]] void centroid(Lanes& out) const { half_sum(min, max, out); }
+        PRISM_FORCE_INLINE void centroid(Lanes& out) const { half_sum(min, max, out); }
         // glm::min(min, other.min) and glm::max, lane by lane in the same operand order.
-        [[gnu::always_inline]] void extend(const BuildBox& other) {
+        PRISM_FORCE_INLINE void extend(const BuildBox& other) {
             keep_min(min, other.min);
             keep_max(max, other.max);
         }
         // glm::min(min, point), as Aabb::extend(point) takes it.
-        [[gnu::always_inline]] void extend(const Lanes& point) {
+        PRISM_FORCE_INLINE void extend(const Lanes& point) {
             keep_min(min, point);
             keep_max(max, point);
         }
@@ -337,7 +338,7 @@ private:
             // Without MarkOccupied, `occupied` is left for merge to find from the counts: in a
             // large node that is a few dozen tests per node instead of three per primitive.
             template <bool MarkOccupied = true>
-            [[gnu::always_inline]] void add(const BuildBox& box, const Bins& bin) {
+            PRISM_FORCE_INLINE void add(const BuildBox& box, const Bins& bin) {
                 for (int axis = 0; axis < 3; ++axis) {
                     bounds[axis][bin[axis]].extend(box);
                     ++counts[axis][bin[axis]];
@@ -389,13 +390,13 @@ private:
             }
             // Where a box's centroid falls, in bins, on every axis at once: the scalar
             // (centroid - low) * scale in its order, lane by lane (one SIMD operation a step).
-            const auto bin_positions = [&](const Lanes& centroid, Lanes& position) __attribute__((always_inline)) {
+            const auto bin_positions = [&](const Lanes& centroid, Lanes& position) PRISM_FORCE_INLINE {
                 shift_scale(centroid, low_lanes, scale_lanes, position);
             };
             // The bins, lane by lane. An axis that cannot be split puts everything in bin 0; so
             // does a NaN centroid (an empty box, e.g. an instance of an empty mesh), which
             // converts to INT_MIN on x86.
-            const auto bins_of = [&](const BuildBox& box) __attribute__((always_inline)) {
+            const auto bins_of = [&](const BuildBox& box) PRISM_FORCE_INLINE {
                 Lanes centroid, position;
                 box.centroid(centroid);
                 bin_positions(centroid, position);
@@ -418,10 +419,10 @@ private:
                     // As in the partition: the largest nodes stream their boxes from memory,
                     // and the box loads were this loop's hottest instructions.
                     simd::prefetch(range[std::min(i + 16, count - 1)]);
-                    bins.add<false>(range[i], bins_of(range[i]));
-                    odd_bins.add<false>(range[i + 1], bins_of(range[i + 1]));
+                    bins.template add<false>(range[i], bins_of(range[i]));
+                    odd_bins.template add<false>(range[i + 1], bins_of(range[i + 1]));
                 }
-                if (i < count) bins.add<false>(range[i], bins_of(range[i]));
+                if (i < count) bins.template add<false>(range[i], bins_of(range[i]));
                 bins.merge(odd_bins, bin_count);
             } else {
                 for (std::uint32_t i = 0; i < count; ++i) bins.add(range[i], bins_of(range[i]));
@@ -497,7 +498,7 @@ private:
                 // (c - low) * scale bins a centroid the same for +0 and -0.
                 std::array<BuildBox, 4> centroid_lanes;  // [2 * odd + left]
                 centroid_lanes.fill(BuildBox::empty());
-                const auto goes_left = [&](const BuildBox& box, std::uint32_t odd) __attribute__((always_inline)) {
+                const auto goes_left = [&](const BuildBox& box, std::uint32_t odd) PRISM_FORCE_INLINE {
                     Lanes centroid, position;
                     box.centroid(centroid);
                     bin_positions(centroid, position);

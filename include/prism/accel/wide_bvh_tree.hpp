@@ -12,6 +12,7 @@
 // mesh be slots [k N, k N + N) (geometry/triangle_packets.hpp).
 #pragma once
 
+#include <prism/math/force_inline.hpp>
 #include <prism/accel/bvh_tree.hpp>
 #include <prism/accel/wide_bvh_node.hpp>
 #include <prism/memory/huge_page_allocator.hpp>
@@ -192,7 +193,7 @@ public:
     std::uint32_t traverse_closest_lanes(const TraversalRay* slabs, const Real* t_min, Real* t_max, std::uint32_t lanes,
                                          Leaf&& leaf) const;
     template <class Each>
-    [[gnu::always_inline]] static std::array<std::uint32_t, N> children_entered(const WideBvhNode<Real, N>& node,
+    PRISM_FORCE_INLINE static std::array<std::uint32_t, N> children_entered(const WideBvhNode<Real, N>& node,
                                                                                  const TraversalRay* slabs, const Real* t_min,
                                                                                  const Real* far_limit, std::uint32_t lanes,
                                                                                  Each&& each);
@@ -204,7 +205,7 @@ public:
     // test's set-up for the tree (geometry/scene_geometry.hpp). With the traversal ray's
     // reciprocals it costs no division, where a box test of its own would divide again; and
     // its eight boxes reject more rays than their union would.
-    [[gnu::always_inline]] bool enters(const TraversalRay& ray, Real t_min, Real t_max) const {
+    PRISM_FORCE_INLINE bool enters(const TraversalRay& ray, Real t_min, Real t_max) const {
         if (nodes_.empty()) return false;
         Pack entry;
         return enter(nodes_[0], ray, t_min, t_max * far_scale, entry).any();
@@ -222,7 +223,7 @@ private:
     // fl(fl(fl(plane - origin) * inverse_direction) * far_scale): two roundings of the same
     // exact product either way, so the relative error bound that makes the test conservative
     // (intersect_box's) holds unchanged; and t_max is widened as before, by one rounded product.
-    [[gnu::always_inline]] static simd::Mask<Real, N> enter(const WideBvhNode<Real, N>& node, const TraversalRay& ray, Real t_min,
+    PRISM_FORCE_INLINE static simd::Mask<Real, N> enter(const WideBvhNode<Real, N>& node, const TraversalRay& ray, Real t_min,
                                                             Real far_limit, Pack& entry) {
         const Real* planes = &node.bounds[0][0];
         Pack t_enter = Pack::broadcast(t_min);
@@ -255,7 +256,7 @@ private:
     // A child pushed on the stack is popped only after the nearer ones: its memory is requested
     // now (the node, or through `touch` the leaf's primitives) so that the wait overlaps them.
     template <class Touch>
-    [[gnu::always_inline]] void prefetch(const StackEntry& entry, Touch& touch) const {
+    PRISM_FORCE_INLINE void prefetch(const StackEntry& entry, Touch& touch) const {
         if (!Node::is_leaf_word(entry.child))
             simd::prefetch(node_at(entry.child));
         else

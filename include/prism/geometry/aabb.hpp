@@ -1,6 +1,7 @@
 // Axis-aligned bounding box, and the slab test the BVH traversal runs at every node.
 #pragma once
 
+#include <prism/math/force_inline.hpp>
 #include <prism/geometry/ray.hpp>
 #include <prism/math/floating_point.hpp>
 
@@ -63,7 +64,7 @@ inline constexpr Real robust_far_scale = Real(1) + 2 * gamma<Real>(3);
 // out-of-line call in front of the world-space index took 10% of the dragon's camera rays
 // (the merged index is entered after this test, once per ray).
 template <Scalar Real>
-[[gnu::always_inline]] inline Real intersect_box(const Aabb<Real>& box, const RayBoxPrecomputed<Real>& ray, Real t_min, Real t_max,
+PRISM_FORCE_INLINE inline Real intersect_box(const Aabb<Real>& box, const RayBoxPrecomputed<Real>& ray, Real t_min, Real t_max,
                           Real far_scale = 1) {
     for (int axis = 0; axis < 3; ++axis) {
         Real t0 = (box.min[axis] - ray.origin[axis]) * ray.inverse_direction[axis];

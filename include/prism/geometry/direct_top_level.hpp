@@ -10,6 +10,7 @@
 // Planes are not here: the index tests them after these (geometry/planes.hpp).
 #pragma once
 
+#include <prism/math/force_inline.hpp>
 #include <prism/geometry/aabb.hpp>
 #include <prism/geometry/backface_culling.hpp>
 #include <prism/geometry/hit.hpp>
@@ -38,11 +39,11 @@ namespace prism {
 // distance that underflows to -0, an origin within a subnormal's width of the face, would
 // pass that test; the ray then starts on the box and the leaf test decides, as here.)
 template <Scalar Real>
-[[gnu::always_inline]] inline bool leaves_box(const Aabb<Real>& box, const Ray<Real>& ray) {
+PRISM_FORCE_INLINE inline bool leaves_box(const Aabb<Real>& box, const Ray<Real>& ray) {
     bool away = false;
     for (int axis = 0; axis < 3; ++axis)
-        away |= (ray.origin[axis] > box.max[axis] && ray.direction[axis] >= 0) |
-                (ray.origin[axis] < box.min[axis] && ray.direction[axis] <= 0);
+        away |= unsigned(ray.origin[axis] > box.max[axis] && ray.direction[axis] >= 0) |
+                unsigned(ray.origin[axis] < box.min[axis] && ray.direction[axis] <= 0);  // no branch
     return away && ray.t_min >= 0;
 }
 
@@ -132,7 +133,7 @@ public:
     // The closest hit among the objects, in their order (spheres, then meshes), below ray.t_max
     // (lowered to it, hit filled); `found`: something nearer was hit already.
     template <BackfaceCulling Culling>
-    [[gnu::always_inline]] bool closest(Ray<Real>& ray, Hit<Real>& hit, bool found) const {
+    PRISM_FORCE_INLINE bool closest(Ray<Real>& ray, Hit<Real>& hit, bool found) const {
         const Candidates may = candidates(ray);
         for (std::uint32_t lanes = may.spheres; lanes != 0; lanes &= lanes - 1) {
             const DirectSphere& sphere = spheres_[std::size_t(std::countr_zero(lanes))];
@@ -345,7 +346,7 @@ private:
     // (a |oc|^2 - b^2 > a r^2, no division). The rounded oc, b and products are off by at most
     // 8 epsilon a |oc|^2 in all (the cancellation when the ray aims at the centre); the test
     // allows twice that. Each lane computes what the scalar dot products compute, in their order.
-    [[gnu::always_inline]] std::uint32_t may_hit(const Ray<Real>& ray) const {
+    PRISM_FORCE_INLINE std::uint32_t may_hit(const Ray<Real>& ray) const {
         const Bounds& bounds = bounds_;
         Lanes oc[3];
         for (int axis = 0; axis < 3; ++axis)
@@ -365,7 +366,7 @@ private:
 
     // Whether the ray meets `sphere` in (ray.t_min, t_max], tested in object space as the
     // index's leaf tests it; for the spheres may_hit lets through.
-    [[gnu::always_inline]] static bool hit_sphere(const DirectSphere& sphere, const Ray<Real>& ray, Real t_max, Real& t) {
+    PRISM_FORCE_INLINE static bool hit_sphere(const DirectSphere& sphere, const Ray<Real>& ray, Real t_max, Real& t) {
         switch (sphere.map) {
             case DirectSphere::Map::none: return sphere.shape.intersect(ray, ray.t_min, t_max, t);
             case DirectSphere::Map::translation: {
@@ -382,14 +383,14 @@ private:
     struct Candidates {
         std::uint32_t spheres = 0, meshes = 0;
     };
-    [[gnu::always_inline]] Candidates candidates(const Ray<Real>& ray) const {
+    PRISM_FORCE_INLINE Candidates candidates(const Ray<Real>& ray) const {
         if (bounds_.lanes == 0) return {};
         const std::uint32_t may = may_hit(ray);
         const std::size_t spheres = spheres_.size();
         return {may & ((std::uint32_t(1) << spheres) - 1), may >> spheres};
     }
     // A direct mesh's ray in its object space, or none where its leaf's box culls it there.
-    [[gnu::always_inline]] static std::optional<Ray<Real>> mesh_ray(const DirectMesh& direct, const Ray<Real>& ray) {
+    PRISM_FORCE_INLINE static std::optional<Ray<Real>> mesh_ray(const DirectMesh& direct, const Ray<Real>& ray) {
         const Ray<Real> local = direct.placement.template ray_to_object<false>(ray);
         if (leaves_box(direct.leaf.box, local)) return std::nullopt;
         return local;

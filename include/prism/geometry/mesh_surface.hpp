@@ -6,6 +6,7 @@
 // index, Embree). The index itself is TriangleMesh (geometry/triangle_mesh.hpp).
 #pragma once
 
+#include <prism/math/force_inline.hpp>
 #include <prism/geometry/hit.hpp>
 #include <prism/geometry/surface_error.hpp>
 #include <prism/geometry/triangle_hit.hpp>
@@ -57,7 +58,7 @@ public:
     // The hit point computed from the barycentrics, with the error bound a leaving ray must
     // clear (geometry/surface_error.hpp), in object space and the precision the triangle is
     // stored in.
-    [[gnu::always_inline]] PointWithError<Real> spawn_point(const Hit<Real>& hit) const {
+    PRISM_FORCE_INLINE PointWithError<Real> spawn_point(const Hit<Real>& hit) const {
         const auto& p = triangles_[hit.primitive];
         return triangle_spawn_point<Real>(p[0], p[1], p[2], hit.b1, hit.b2);
     }

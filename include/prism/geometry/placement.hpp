@@ -7,6 +7,7 @@
 // whole sweep (the boxes at t = 0 and t = 1 together, exact for a translation).
 #pragma once
 
+#include <prism/math/force_inline.hpp>
 #include <prism/geometry/aabb.hpp>
 #include <prism/geometry/ray.hpp>
 #include <prism/geometry/sphere.hpp>
@@ -68,16 +69,16 @@ struct Placement {
 
     // Forced inline: the direct spheres' test calls it for every ray a transformed sphere may
     // meet, and GCC left it out of line there (8% of hw2 spheres.json).
-    [[gnu::always_inline]] Vec3<Real> to_object(const Vec3<Real>& p) const { return transform_point(world_to_object, p); }
+    PRISM_FORCE_INLINE Vec3<Real> to_object(const Vec3<Real>& p) const { return transform_point(world_to_object, p); }
     // The direction is transformed but not renormalised, so t means the same in both spaces.
-    [[gnu::always_inline]] Ray<Real> to_object(const Ray<Real>& ray) const {
+    PRISM_FORCE_INLINE Ray<Real> to_object(const Ray<Real>& ray) const {
         return {to_object(ray.origin), transform_direction(world_to_object_linear, ray.direction), ray.t_min, ray.t_max,
                 ray.time};
     }
 
     // Where a moving object has gone by the instant `time`; zero without motion blur.
     template <bool MotionBlur>
-    [[gnu::always_inline]] Vec3<Real> displacement(Real time) const {
+    PRISM_FORCE_INLINE Vec3<Real> displacement(Real time) const {
         if constexpr (MotionBlur) {
             if (moving) return motion * time;
         }
@@ -87,7 +88,7 @@ struct Placement {
     // The ray in object space, at the ray's instant for a moving object. Forced inline as
     // to_object is (the top level's leaf and the direct meshes call it).
     template <bool MotionBlur>
-    [[gnu::always_inline]] Ray<Real> ray_to_object(const Ray<Real>& ray) const {
+    PRISM_FORCE_INLINE Ray<Real> ray_to_object(const Ray<Real>& ray) const {
         if constexpr (MotionBlur) {
             if (moving) {
                 Ray<Real> unmoved = ray;

@@ -3,6 +3,7 @@
 // index holds them: every ray tests each one, eight at a time in SIMD lanes.
 #pragma once
 
+#include <prism/math/force_inline.hpp>
 #include <prism/geometry/backface_culling.hpp>
 #include <prism/geometry/hit.hpp>
 #include <prism/geometry/ray.hpp>
@@ -44,7 +45,7 @@ struct PlaneShape {
 
     // Forced inline: out of line, the planes' loop in front of every shadow ray's light took 17%
     // of hw2 mirror_room (5 planes).
-    [[gnu::always_inline]] bool intersect(const Ray<Real>& ray, Real t_min, Real t_max, Real& t_hit) const {
+    PRISM_FORCE_INLINE bool intersect(const Ray<Real>& ray, Real t_min, Real t_max, Real& t_hit) const {
         const Real denominator = glm::dot(ray.direction, normal);
         if (denominator == 0) return false;
         const Real numerator = glm::dot(point - ray.origin, normal);
@@ -128,7 +129,7 @@ private:
     // t that t_max has not yet been compared with; t and the denominator (direction . normal)
     // stored. The scalar test's shortcut for planes behind the ray only skips a division whose
     // t would fail t > t_min >= 0 anyway, so every lane divides.
-    [[gnu::always_inline]] static std::uint32_t distances(const Block& block, const Ray<Real>& ray, Real* t,
+    PRISM_FORCE_INLINE static std::uint32_t distances(const Block& block, const Ray<Real>& ray, Real* t,
                                                           Real* denominator) {
         Lanes normal[3], along[3];
         for (int axis = 0; axis < 3; ++axis) {

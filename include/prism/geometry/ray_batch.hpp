@@ -10,6 +10,7 @@
 // answer is the one it gets alone, to the bit (the tie rule: geometry/scene_index_lanes.hpp).
 #pragma once
 
+#include <prism/math/force_inline.hpp>
 #include <prism/geometry/backface_culling.hpp>
 #include <prism/geometry/hit.hpp>
 #include <prism/geometry/ray.hpp>
@@ -50,14 +51,14 @@ inline BackfaceCulling culling_at_depth(BackfaceCulling culling, int depth) {
 // One ray's closest hit: a batch of one. Inlined, so that the batch's count and mask are known
 // to the index's entry, which then reduces to its one-ray traversal.
 template <class Index, Scalar Real>
-[[gnu::always_inline]] inline bool closest_hit(const Index& index, Ray<Real>& ray, Hit<Real>& hit,
+PRISM_FORCE_INLINE inline bool closest_hit(const Index& index, Ray<Real>& ray, Hit<Real>& hit,
                                                BackfaceCulling culling = BackfaceCulling::none) {
     return index.intersect(RayBatch<Real>{&ray, 1, 1, culling}, &hit) != 0;
 }
 
 // Whether one ray is blocked: a batch of one.
 template <class Index, Scalar Real>
-[[gnu::always_inline]] inline bool blocked(const Index& index, const Ray<Real>& ray) {
+PRISM_FORCE_INLINE inline bool blocked(const Index& index, const Ray<Real>& ray) {
     return index.occluded(RayBatch<Real>{const_cast<Ray<Real>*>(&ray), 1, 1, BackfaceCulling::none}) != 0;
 }
 

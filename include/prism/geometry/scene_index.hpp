@@ -9,6 +9,7 @@
 // geometry/scene_index_lanes.hpp. What a hit means is SceneSurfaces'; SceneGeometry pairs the two.
 #pragma once
 
+#include <prism/math/force_inline.hpp>
 #include <prism/accel/accelerator.hpp>
 #include <prism/geometry/backface_culling.hpp>
 #include <prism/geometry/direct_top_level.hpp>
@@ -126,7 +127,7 @@ public:
     // which leaves are visited only when two candidates tie, and a ray whose hit in a lane
     // traversal came at exactly the t_max it was given is traced again on its own.
     // A batch of one is inlined into the caller down to closest_one's dispatch.
-    [[gnu::always_inline]] std::uint32_t intersect(const RayBatch<Real>& batch, Hit<Real>* hits) const {
+    PRISM_FORCE_INLINE std::uint32_t intersect(const RayBatch<Real>& batch, Hit<Real>* hits) const {
         if (batch.count == 1) {
             if (!(batch.active & 1)) return 0;
             switch (batch.culling) {
@@ -141,7 +142,7 @@ public:
 
     // The one any-hit entry: bit i set where something lies in (t_min, t_max) of active ray i
     // (open at t_max: a shadow ray aimed at a point on a surface is not blocked by it).
-    [[gnu::always_inline]] std::uint32_t occluded(const RayBatch<Real>& batch) const {
+    PRISM_FORCE_INLINE std::uint32_t occluded(const RayBatch<Real>& batch) const {
         if (batch.count == 1) return (batch.active & 1) && occluded_one(batch.rays[0]);
         return occluded_many(batch);
     }
@@ -174,7 +175,7 @@ private:
     // inlining the whole, and every camera ray of the sphere scenes paid a call and its spills
     // (3% of hw1 simple_shading's CPU time, 8-13% of hw1 two_spheres').
     template <BackfaceCulling Culling>
-    [[gnu::always_inline]] bool closest_one(Ray<Real>& ray, Hit<Real>& hit) const {
+    PRISM_FORCE_INLINE bool closest_one(Ray<Real>& ray, Hit<Real>& hit) const {
         if (direct_form_) {
             const bool found = !world_meshes_.empty() && (several_leaves_ ? intersect_world_leaves<Culling, true>(ray, hit)
                                                                        : intersect_world_leaves<Culling, false>(ray, hit));
@@ -217,7 +218,7 @@ private:
     }
 
     // The any-hit query of one ray.
-    [[gnu::always_inline]] bool occluded_one(const Ray<Real>& ray) const {
+    PRISM_FORCE_INLINE bool occluded_one(const Ray<Real>& ray) const {
         if (direct_form_) return occluded_without_index(ray);
         return occluded_indexed(ray);
     }
@@ -339,17 +340,17 @@ private:
     std::uint32_t intersect_in_object_space(const Placement<Real>& instance, const Ray<Real>* rays, const Real* t_min,
                                             Real* t_max, std::uint32_t lanes, Hit<Real>* hits, std::uint32_t& tied) const
         requires Mesh::packed;
-    std::uint32_t occluded_through_index(const Ray<Real>* rays, int count) const
-        requires Mesh::packed;
+    // Called only where Mesh::packed (under if constexpr): a trailing requires-clause on these
+    // two, out of line, is more than clang 14 can match to its declaration.
+    std::uint32_t occluded_through_index(const Ray<Real>* rays, int count) const;
     std::uint32_t occludes_in_object_space(const Placement<Real>& instance, const Ray<Real>* rays, const Real* t_min,
-                                           const Real* t_max, std::uint32_t lanes) const
-        requires Mesh::packed;
+                                           const Real* t_max, std::uint32_t lanes) const;
     struct ObjectSpaceRays;
     struct WorldSpaceRays;
-    [[gnu::always_inline]] static std::uint32_t lanes_reaching(const typename Mesh::Leaf& leaf, const Ray<Real>* rays,
+    PRISM_FORCE_INLINE static std::uint32_t lanes_reaching(const typename Mesh::Leaf& leaf, const Ray<Real>* rays,
                                                                int n, std::uint32_t skip);
     template <class Packets>
-    [[gnu::always_inline]] static typename Packets::LanePack lanes_t_max(const Ray<Real>* rays, int n);
+    PRISM_FORCE_INLINE static typename Packets::LanePack lanes_t_max(const Ray<Real>* rays, int n);
 
     using Kind = typename Placement<Real>::Kind;
     using Direct = DirectTopLevel<Real, Mesh>;
@@ -380,7 +381,7 @@ private:
     // intersect_indexed past the world meshes: the top level (direct or through its index),
     // then the planes; `found` whether the world meshes were hit.
     template <BackfaceCulling Culling>
-    [[gnu::always_inline]] bool intersect_top(Ray<Real>& ray, Hit<Real>& hit, bool found, const TraversalRay& traversal_ray,
+    PRISM_FORCE_INLINE bool intersect_top(Ray<Real>& ray, Hit<Real>& hit, bool found, const TraversalRay& traversal_ray,
                                               std::optional<TriangleRay>& world_triangle_ray) const {
         if (direct_.chosen()) return closest_direct<Culling>(ray, hit, found);
         if (top_objects_.empty()) return planes_.template closest<Culling>(ray, hit) || found;
@@ -402,11 +403,11 @@ private:
 
     // The direct top level's closest hit, then the planes'; `found`: something nearer was hit.
     template <BackfaceCulling Culling>
-    [[gnu::always_inline]] bool closest_direct(Ray<Real>& ray, Hit<Real>& hit, bool found) const {
+    PRISM_FORCE_INLINE bool closest_direct(Ray<Real>& ray, Hit<Real>& hit, bool found) const {
         found = direct_.template closest<Culling>(ray, hit, found);
         return planes_.template closest<Culling>(ray, hit) || found;
     }
-    [[gnu::always_inline]] bool occluded_direct(const Ray<Real>& ray) const {
+    PRISM_FORCE_INLINE bool occluded_direct(const Ray<Real>& ray) const {
         return direct_.occludes(ray) || planes_.occludes(ray);
     }
 
@@ -429,7 +430,7 @@ private:
     // Forced inline, as occludes below: the top level's leaf callbacks call them for every
     // object they reach, and with to_object forced inline GCC put both out of line (nm).
     template <BackfaceCulling Culling>
-    [[gnu::always_inline]] bool intersect_instance(const Placement<Real>& instance, const Ray<Real>& ray,
+    PRISM_FORCE_INLINE bool intersect_instance(const Placement<Real>& instance, const Ray<Real>& ray,
                                                    const TraversalRay& traversal_ray,
                                                    std::optional<TriangleRay>& world_triangle_ray, Real& t_max,
                                                    Hit<Real>& hit) const {
@@ -456,7 +457,7 @@ private:
         return true;
     }
 
-    [[gnu::always_inline]] bool occludes(const Placement<Real>& instance, const Ray<Real>& ray, const TraversalRay& traversal_ray,
+    PRISM_FORCE_INLINE bool occludes(const Placement<Real>& instance, const Ray<Real>& ray, const TraversalRay& traversal_ray,
                   std::optional<TriangleRay>& world_triangle_ray, Real t_max) const {
         if (instance.kind == Kind::mesh && instance.template in_world_space<MotionBlur>()) {
             if (!world_triangle_ray) world_triangle_ray.emplace(ray);
@@ -530,7 +531,7 @@ private:
     // leaves by their boxes' entry distances: those rays (an edge shared by two leaves) are
     // handed to the traversal itself, from the state before any leaf.
     template <bool CullBackfaces, bool Several>
-    [[gnu::always_inline]] static bool intersect_root_leaves(const Mesh& index, const typename Mesh::RootLeaves& leaves,
+    PRISM_FORCE_INLINE static bool intersect_root_leaves(const Mesh& index, const typename Mesh::RootLeaves& leaves,
                                                              Ray<Real>& ray, std::optional<TriangleRay>& triangle_ray,
                                                              Hit<Real>& hit) {
         const auto& first = leaves.leaf[0];
@@ -567,7 +568,7 @@ private:
     }
 
     // occluded for direct_form_: the world meshes' leaves, then the direct top level and planes.
-    [[gnu::always_inline]] bool occluded_without_index(const Ray<Real>& ray) const {
+    PRISM_FORCE_INLINE bool occluded_without_index(const Ray<Real>& ray) const {
         return (!world_meshes_.empty() && (several_leaves_ ? occluded_world_leaves<true>(ray) : occluded_world_leaves<false>(ray))) ||
                occluded_direct(ray);
     }

@@ -386,9 +386,7 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_in_object_space(co
 // three instanced horses: the shadow rays were a third of its time).
 template <Scalar Real, class Policy, bool MotionBlur>
     requires AccelerationPolicy<Policy, Real>
-std::uint32_t SceneIndex<Real, Policy, MotionBlur>::occluded_through_index(const Ray<Real>* rays, int count) const
-    requires Mesh::packed
-{
+std::uint32_t SceneIndex<Real, Policy, MotionBlur>::occluded_through_index(const Ray<Real>* rays, int count) const {
     const std::uint32_t present = (std::uint32_t(1) << count) - 1;
     WorldSpaceRays world(rays, count);
     const Real* const t_min = world.t_min;
@@ -443,9 +441,7 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::occluded_through_index(const
 template <Scalar Real, class Policy, bool MotionBlur>
     requires AccelerationPolicy<Policy, Real>
 std::uint32_t SceneIndex<Real, Policy, MotionBlur>::occludes_in_object_space(const Placement<Real>& instance, const Ray<Real>* rays, const Real* t_min,
-                                       const Real* t_max, std::uint32_t lanes) const
-    requires Mesh::packed
-{
+                                       const Real* t_max, std::uint32_t lanes) const {
     std::uint32_t blocked = 0;
     if (instance.kind != Kind::mesh) {
         for (; lanes != 0; lanes &= lanes - 1) {

@@ -7,6 +7,7 @@
 // planes after them.
 #pragma once
 
+#include <prism/math/force_inline.hpp>
 #include <prism/geometry/backface_culling.hpp>
 #include <prism/geometry/hit.hpp>
 #include <prism/geometry/mesh_surface.hpp>
@@ -93,7 +94,7 @@ public:
     }
     template <bool Parametrised>
         requires(!Parametrised)
-    [[gnu::always_inline]] SurfacePoint<Real> surface(const Ray<Real>& ray, const Hit<Real>& hit,
+    PRISM_FORCE_INLINE SurfacePoint<Real> surface(const Ray<Real>& ray, const Hit<Real>& hit,
                                                       bool spawn_point = true) const {
         return surface_of<false>(ray, hit, spawn_point);
     }
@@ -127,7 +128,7 @@ public:
     // Rays that leave one point by the same side start from the same origin, so the shadow rays
     // to every light can share one (the error-bounded origin of an instance was a third of
     // hw2 metal_glass_plates' time, computed again for each of its lights).
-    [[gnu::always_inline]] int spawn_side(const SurfacePoint<Real>& point, const Vec3<Real>& direction) const {
+    PRISM_FORCE_INLINE int spawn_side(const SurfacePoint<Real>& point, const Vec3<Real>& direction) const {
         if (point.object >= instances_.size()) return glm::dot(direction, point.object_normal) < 0;
         const Instance& instance = instances_[point.object];
         int side = instance.transformed
@@ -182,7 +183,7 @@ private:
     };
 
     template <bool Parametrised>
-    [[gnu::always_inline]] SurfacePoint<Real> surface_of(const Ray<Real>& ray, const Hit<Real>& hit,
+    PRISM_FORCE_INLINE SurfacePoint<Real> surface_of(const Ray<Real>& ray, const Hit<Real>& hit,
                                                          bool spawn_point) const {
         SurfacePoint<Real> point;
         point.position = ray.at(hit.t);

@@ -8,6 +8,7 @@
 // bounds (pbrt-v4's double build silently used float-sized ones).
 #pragma once
 
+#include <prism/math/force_inline.hpp>
 #include <prism/math/floating_point.hpp>
 #include <prism/math/transform.hpp>
 
@@ -31,7 +32,7 @@ struct PointWithError {
 // exactly 1, the point moves by (sum - 1) p_i, whose component along the normal is
 // (sum - 1) (n . p_hit), within a few u of sum |b_i p_i|; gamma(7) covers it.
 template <Scalar Real>
-[[gnu::always_inline]] inline PointWithError<Real> triangle_hit_point(const Vec3<Real>& p0, const Vec3<Real>& p1,
+PRISM_FORCE_INLINE inline PointWithError<Real> triangle_hit_point(const Vec3<Real>& p0, const Vec3<Real>& p1,
                                                                       const Vec3<Real>& p2, Real b1, Real b2) {
     const Real b0 = Real(1) - b1 - b2;
     const Vec3<Real> w0 = b0 * p0, w1 = b1 * p1, w2 = b2 * p2;
@@ -72,7 +73,7 @@ PointWithError<Real> triangle_hit_point(const Vec3<double>& p0, const Vec3<doubl
 // vectors passed through memory cost hw1 simple_shading 2% of its instructions (GCC inlines it
 // or not as the shading code around it grows).
 template <Scalar Real, Scalar Vertex>
-[[gnu::always_inline]] inline PointWithError<Real> triangle_spawn_point(const Vec3<Vertex>& p0, const Vec3<Vertex>& p1,
+PRISM_FORCE_INLINE inline PointWithError<Real> triangle_spawn_point(const Vec3<Vertex>& p0, const Vec3<Vertex>& p1,
                                                                         const Vec3<Vertex>& p2, Real b1, Real b2) {
     PointWithError<Real> result = triangle_hit_point(p0, p1, p2, b1, b2);
     // In double for both precisions: R^3 overflows float for coordinates past ~1e12.

@@ -6,6 +6,7 @@
 // (geometry/mesh_surface.hpp), which keeps the triangles in the same slot order.
 #pragma once
 
+#include <prism/math/force_inline.hpp>
 #include <prism/accel/accelerator.hpp>
 #include <prism/geometry/hit.hpp>
 #include <prism/geometry/surface_error.hpp>
@@ -87,7 +88,7 @@ public:
 
     // Whether a ray may reach a leaf of the index, decided by the index's own first node test
     // (WideBvhTree::enters); only for an index that has one.
-    [[gnu::always_inline]] bool enters(const TraversalRay& ray, Real t_min, Real t_max) const
+    PRISM_FORCE_INLINE bool enters(const TraversalRay& ray, Real t_min, Real t_max) const
         requires requires(const Index& index) { index.enters(ray, t_min, t_max); }
     {
         return index_.enters(ray, t_min, t_max);
@@ -141,7 +142,7 @@ public:
     // order, so the same hit (closest in (ray.t_min, t_max], later ties winning; t_max lowered)
     // and the same any-hit answer (open at t_max).
     template <bool CullBackfaces>
-    [[gnu::always_inline]] bool intersect_leaf(const Ray<Real>& ray, const TriangleRay& triangle_ray, Leaf leaf, Real& t_max,
+    PRISM_FORCE_INLINE bool intersect_leaf(const Ray<Real>& ray, const TriangleRay& triangle_ray, Leaf leaf, Real& t_max,
                                                Hit<Real>& hit) const
         requires packed
     {
@@ -151,20 +152,20 @@ public:
     // The same leaf against several rays, one in each lane (TrianglePackets::intersect_lanes):
     // each lane's hit is the one intersect_leaf gives its ray.
     template <bool CullBackfaces, class RayLanes, class LaneHits>
-    [[gnu::always_inline]] void intersect_leaf_lanes(const RayLanes& rays, Leaf leaf, std::uint32_t lanes,
+    PRISM_FORCE_INLINE void intersect_leaf_lanes(const RayLanes& rays, Leaf leaf, std::uint32_t lanes,
                                                      LaneHits& hits) const
         requires packed
     {
         packets_.template intersect_lanes<CullBackfaces>(rays, leaf.first, leaf.count, lanes, hits);
     }
     template <class RayLanes, class LanePack>
-    [[gnu::always_inline]] std::uint32_t occluded_leaf_lanes(const RayLanes& rays, Leaf leaf, std::uint32_t lanes,
+    PRISM_FORCE_INLINE std::uint32_t occluded_leaf_lanes(const RayLanes& rays, Leaf leaf, std::uint32_t lanes,
                                                              const LanePack& t_max) const
         requires packed
     {
         return packets_.occluded_lanes(rays, leaf.first, leaf.count, lanes, t_max);
     }
-    [[gnu::always_inline]] bool occluded_leaf(const Ray<Real>& ray, const TriangleRay& triangle_ray, Leaf leaf, Real t_max) const
+    PRISM_FORCE_INLINE bool occluded_leaf(const Ray<Real>& ray, const TriangleRay& triangle_ray, Leaf leaf, Real t_max) const
         requires packed
     {
         return packets_.occluded(triangle_ray.packed_ray, leaf.first, leaf.count, ray.t_min, t_max);

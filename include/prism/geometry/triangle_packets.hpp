@@ -8,6 +8,7 @@
 // DoubleRefine runs the same test on packets of double vertices under float traversal.
 #pragma once
 
+#include <prism/math/force_inline.hpp>
 #include <prism/geometry/double_refine.hpp>
 #include <prism/geometry/hit.hpp>
 #include <prism/geometry/watertight.hpp>
@@ -97,7 +98,7 @@ public:
     // Forced inline into the traversal's leaf callback, as is `test`: GCC had kept it a function
     // of its own (26% of a dragon primary profile), called once per leaf.
     template <bool CullBackfaces>
-    [[gnu::always_inline]] bool intersect(const PackedRay& ray, const Vec3<Real>& direction, std::uint32_t first, std::uint32_t count,
+    PRISM_FORCE_INLINE bool intersect(const PackedRay& ray, const Vec3<Real>& direction, std::uint32_t first, std::uint32_t count,
                    Real t_min, Real& t_limit, Hit<Real>& hit) const {
         bool found = false;
         const LeafRay leaf_ray(ray.ray);
@@ -211,7 +212,7 @@ public:
     // Closest hits among slots [first, first + count) for the lanes of `lanes`.
     template <bool CullBackfaces>
         requires tests_ray_lanes
-    [[gnu::always_inline]] void intersect_lanes(const RayLanes& rays, std::uint32_t first, std::uint32_t count,
+    PRISM_FORCE_INLINE void intersect_lanes(const RayLanes& rays, std::uint32_t first, std::uint32_t count,
                                                 std::uint32_t lanes, LaneHits& hits) const {
         for (std::uint32_t slot = first; slot < first + count; ++slot) {
             SlotLanes test;
@@ -229,7 +230,7 @@ public:
 
     // The lanes of `lanes` that meet one of slots [first, first + count) in (t_min, t_max), each
     // lane's answer the scalar `occluded`'s for its ray (open at t_max).
-    [[gnu::always_inline]] std::uint32_t occluded_lanes(const RayLanes& rays, std::uint32_t first, std::uint32_t count,
+    PRISM_FORCE_INLINE std::uint32_t occluded_lanes(const RayLanes& rays, std::uint32_t first, std::uint32_t count,
                                                         std::uint32_t lanes, const LanePack& t_max) const
         requires tests_ray_lanes
     {
@@ -255,7 +256,7 @@ public:
     PRISM_PREFETCH_INLINE void prefetch(std::uint32_t first) const { simd::prefetch(packets_[first / N]); }
 
     // Whether any of slots [first, first + count) is hit in (t_min, t_limit).
-    [[gnu::always_inline]] bool occluded(const PackedRay& ray, std::uint32_t first, std::uint32_t count, Real t_min, Real t_limit) const {
+    PRISM_FORCE_INLINE bool occluded(const PackedRay& ray, std::uint32_t first, std::uint32_t count, Real t_min, Real t_limit) const {
         const LeafRay leaf_ray(ray.ray);
         for (std::uint32_t base = first; base < first + count; base += N) {
             alignas(64) Storage t[N], b1[N], b2[N];
@@ -290,7 +291,7 @@ private:
     };
     // False where no lane of `lanes` is accepted (t left uncomputed).
     template <bool CullBackfaces>
-    [[gnu::always_inline]] bool test_slot(const RayLanes& rays, std::uint32_t slot, std::uint32_t lanes, SlotLanes& out) const {
+    PRISM_FORCE_INLINE bool test_slot(const RayLanes& rays, std::uint32_t slot, std::uint32_t lanes, SlotLanes& out) const {
         const LanePack zero = LanePack::broadcast(0);
         const Packet& packet = packets_[slot / N];
         const std::size_t lane_of_slot = slot % N;
@@ -381,7 +382,7 @@ private:
         Pack origin_x, origin_y, origin_z;  // along kx, ky, kz
         Pack sx, sy, sz;
         std::size_t row_x, row_y, row_z;  // bytes from a packet's start to vertex 0's row along kx, ky, kz
-        [[gnu::always_inline]] explicit LeafRay(const Watertight::Prepared<Storage>& ray)
+        PRISM_FORCE_INLINE explicit LeafRay(const Watertight::Prepared<Storage>& ray)
             : origin_x(Pack::broadcast(glm::value_ptr(ray.origin)[ray.kx])),
               origin_y(Pack::broadcast(glm::value_ptr(ray.origin)[ray.ky])),
               origin_z(Pack::broadcast(glm::value_ptr(ray.origin)[ray.kz])),
@@ -393,7 +394,7 @@ private:
 
     // Watertight::intersect on every lane: the lanes hit in (t_min, t_max], with their t and
     // barycentrics stored. Same operations, same order, so the same bits as the scalar test.
-    [[gnu::always_inline]] static std::uint32_t test(const Packet& packet, const LeafRay& ray, Storage t_min, Storage t_max,
+    PRISM_FORCE_INLINE static std::uint32_t test(const Packet& packet, const LeafRay& ray, Storage t_min, Storage t_max,
                               Storage* t_out, Storage* b1_out, Storage* b2_out) {
         static_assert(std::is_standard_layout_v<Packet> && offsetof(Packet, vertices) == 0);
         const auto* packet_bytes = reinterpret_cast<const unsigned char*>(&packet);

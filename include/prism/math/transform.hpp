@@ -5,6 +5,7 @@
 // then B" is the product B * A.
 #pragma once
 
+#include <prism/math/force_inline.hpp>
 #include <prism/math/vector.hpp>
 
 #include <glm/glm.hpp>
@@ -38,7 +39,7 @@ inline glm::dmat4 composite_from_row_major(const std::array<double, 16>& rows) {
 // geometry/surface_error.hpp relies on. Written out rather than through GLM so that it inlines:
 // GCC left GLM's product out of line on the spawn and hit-point paths of instanced scenes.
 template <Scalar Real>
-[[gnu::always_inline]] inline Vec3<Real> transform_point(const Mat4<Real>& matrix, const Vec3<Real>& point) {
+PRISM_FORCE_INLINE inline Vec3<Real> transform_point(const Mat4<Real>& matrix, const Vec3<Real>& point) {
     Vec3<Real> result;
     for (int row = 0; row < 3; ++row)
         result[row] = (matrix[0][row] * point.x + matrix[1][row] * point.y) + (matrix[2][row] * point.z + matrix[3][row]);
@@ -48,7 +49,7 @@ template <Scalar Real>
 // A 3x3 matrix applied to a vector, summed as (m0 x + m1 y) + m2 z: GLM's order and bits,
 // written out to inline for the same reason as transform_point.
 template <Scalar Real>
-[[gnu::always_inline]] inline Vec3<Real> transform_direction(const Mat3<Real>& matrix, const Vec3<Real>& direction) {
+PRISM_FORCE_INLINE inline Vec3<Real> transform_direction(const Mat3<Real>& matrix, const Vec3<Real>& direction) {
     Vec3<Real> result;
     for (int row = 0; row < 3; ++row)
         result[row] = matrix[0][row] * direction.x + matrix[1][row] * direction.y + matrix[2][row] * direction.z;
@@ -58,7 +59,7 @@ template <Scalar Real>
 // Directions (gaze, up, ray directions, tangents) ignore the translation. Not renormalised: a
 // ray direction scaled with the object keeps its parameter t meaning the same distance.
 template <Scalar Real>
-[[gnu::always_inline]] inline Vec3<Real> transform_direction(const Mat4<Real>& matrix, const Vec3<Real>& direction) {
+PRISM_FORCE_INLINE inline Vec3<Real> transform_direction(const Mat4<Real>& matrix, const Vec3<Real>& direction) {
     return transform_direction(Mat3<Real>(matrix), direction);
 }
 
@@ -71,7 +72,7 @@ Mat3<Real> normal_matrix(const Mat4<Real>& matrix) {
 
 // Not renormalised, as the caller usually normalises after interpolation anyway.
 template <Scalar Real>
-[[gnu::always_inline]] inline Vec3<Real> transform_normal(const Mat3<Real>& inverse_transpose, const Vec3<Real>& normal) {
+PRISM_FORCE_INLINE inline Vec3<Real> transform_normal(const Mat3<Real>& inverse_transpose, const Vec3<Real>& normal) {
     return transform_direction(inverse_transpose, normal);
 }
 

@@ -3,6 +3,8 @@
 // any header sees the types it works with.
 #pragma once
 
+#include <prism/math/force_inline.hpp>
+
 #include <glm/glm.hpp>
 
 #include <cmath>
@@ -37,7 +39,7 @@ inline int max_dimension(const Vec3<Real>& v) {
 // integrators, a call per camera ray, shadow ray and half vector: 4-6% of the samples of the
 // course's sphere scenes (hw1 spheres.json, hw2 mirror_room.json) were the call alone.
 template <Scalar Real>
-[[gnu::always_inline]] inline Vec3<Real> unit_vector(const Vec3<Real>& v) {
+PRISM_FORCE_INLINE inline Vec3<Real> unit_vector(const Vec3<Real>& v) {
     return v * (Real(1) / std::sqrt(glm::dot(v, v)));
 }
 
@@ -48,7 +50,7 @@ template <Scalar Real>
 // of a NaN), which no bound that uses this can see: the bounds are sums of magnitudes that end
 // up added to a positive margin.
 template <Scalar Real>
-[[gnu::always_inline]] inline Vec3<Real> abs_each(const Vec3<Real>& v) {
+PRISM_FORCE_INLINE inline Vec3<Real> abs_each(const Vec3<Real>& v) {
     return {std::abs(v.x), std::abs(v.y), std::abs(v.z)};
 }
 

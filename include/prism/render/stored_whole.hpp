@@ -8,6 +8,7 @@
 // and simple_shading; after leaving_ray's, 29% of trace's samples in hw2 mirror_room.
 #pragma once
 
+#include <prism/math/force_inline.hpp>
 #include <prism/geometry/ray.hpp>
 
 #include <cstring>
@@ -17,7 +18,7 @@ namespace prism {
 
 // The same ray, bit for bit. Float rays (36 bytes) only; double ones are returned as they are.
 template <Scalar Real>
-[[gnu::always_inline]] inline Ray<Real> stored_whole(const Ray<Real>& ray) {
+PRISM_FORCE_INLINE inline Ray<Real> stored_whole(const Ray<Real>& ray) {
 #if defined(__GNUC__) || defined(__clang__)  // vector extensions; elsewhere the ray as it is
     if constexpr (std::is_same_v<Real, float> && sizeof(Ray<float>) == 9 * sizeof(float)) {
         typedef float Lanes __attribute__((vector_size(32)));

@@ -7,6 +7,7 @@
 // Roughness perturbing each reflected and refracted direction once per camera sample.
 #pragma once
 
+#include <prism/math/force_inline.hpp>
 #include <prism/geometry/backface_culling.hpp>
 #include <prism/geometry/hit.hpp>
 #include <prism/geometry/ray_batch.hpp>
@@ -49,7 +50,7 @@ enum class RayOffset {
 // stay in registers for stored_whole (render/stored_whole.hpp): called out of line, it answered
 // through memory, and the copy of that answer into trace's argument waited for its stores.
 template <Scalar Real, class Geometry>
-[[gnu::always_inline]] inline Ray<Real> leaving_ray(const Geometry& geometry, RayOffset offset, Real epsilon,
+PRISM_FORCE_INLINE inline Ray<Real> leaving_ray(const Geometry& geometry, RayOffset offset, Real epsilon,
                                                     const SurfacePoint<Real>& point, const Vec3<Real>& normal,
                                                     const Vec3<Real>& direction, Real time) {
     Ray<Real> ray{Vec3<Real>(0), direction, Real(0), infinity<Real>, time};
@@ -90,7 +91,7 @@ inline constexpr bool textured = !std::is_same_v<Textures, NoTextures<Real>>;
 // the exact point with its error bound only where rays leave by it (RayOffset::error_bound).
 // Inlined into trace, so that surface<false> is (SceneSurfaces::surface).
 template <bool Textured, Scalar Real, class Geometry>
-[[gnu::always_inline]] inline SurfacePoint<Real> shading_surface(const Geometry& geometry, const Ray<Real>& ray, const Hit<Real>& hit,
+PRISM_FORCE_INLINE inline SurfacePoint<Real> shading_surface(const Geometry& geometry, const Ray<Real>& ray, const Hit<Real>& hit,
                                    RayOffset offset) {
     return geometry.template surface<Textured>(ray, hit, offset == RayOffset::error_bound);
 }
@@ -100,7 +101,7 @@ template <bool Textured, Scalar Real, class Geometry>
 // sphere's (its acos, atan2 and sincos) were 4% of hw7 path_glass's time in the renderer that
 // every path-traced scene takes (all features compiled in).
 template <class Textures, Scalar Real, class Geometry>
-[[gnu::always_inline]] inline SurfacePoint<Real> shading_surface(const Geometry& geometry, const Textures& textures,
+PRISM_FORCE_INLINE inline SurfacePoint<Real> shading_surface(const Geometry& geometry, const Textures& textures,
                                                                  const Ray<Real>& ray, const Hit<Real>& hit,
                                                                  RayOffset offset) {
     if constexpr (textured<Textures, Real>) {
@@ -267,7 +268,7 @@ private:
 
     // The radiance leaving the hit `hit` of `ray` back along it: trace's work past the
     // intersection.
-    [[gnu::always_inline]] Vec3<Real> shade(const Ray<Real>& ray, const Hit<Real>& hit, int depth, CameraPath& path,
+    PRISM_FORCE_INLINE Vec3<Real> shade(const Ray<Real>& ray, const Hit<Real>& hit, int depth, CameraPath& path,
                                             Real travelled) const {
         SurfacePoint<Real> point = shading_surface(geometry_, textures_, ray, hit, settings_.ray_offset);
         // Textures change a copy; without them the material is read where it is stored.
@@ -307,7 +308,7 @@ private:
 
     // shade's work past the direct lighting: the reflected (and refracted) rays traced, and
     // Beer's law inside a medium; `color` is the point's own (emitted, ambient, direct).
-    [[gnu::always_inline]] Vec3<Real> reflect_and_absorb(const Ray<Real>& ray, const Hit<Real>& hit,
+    PRISM_FORCE_INLINE Vec3<Real> reflect_and_absorb(const Ray<Real>& ray, const Hit<Real>& hit,
                                                          const SurfacePoint<Real>& point, const Material<Real>& material,
                                                          const Vec3<Real>& normal, bool front_face, bool inside_medium,
                                                          Vec3<Real> color, int depth, CameraPath& path, Real travelled,
@@ -341,7 +342,7 @@ private:
 
     // The ray a surface that is not Blinn-Phong reflects toward (perturbed by its roughness,
     // drawing from the path's stream), and the cosine of incidence it was made with.
-    [[gnu::always_inline]] Ray<Real> reflection_of(const Ray<Real>& ray, const SurfacePoint<Real>& point,
+    PRISM_FORCE_INLINE Ray<Real> reflection_of(const Ray<Real>& ray, const SurfacePoint<Real>& point,
                                                    const Material<Real>& material, const Vec3<Real>& normal,
                                                    CameraPath& path, SpawnOrigins& origins, Real& cos_incident) const {
         const Vec3<Real>& d = ray.direction;
@@ -354,7 +355,7 @@ private:
     // What a mirror's or a conductor's reflected radiance is multiplied by: its MirrorReflectance,
     // times the conductor's Fresnel reflectance (fresnel * mirror, then the radiance: the
     // products in the order the expression always took them).
-    [[gnu::always_inline]] Vec3<Real> reflection_weight(const Material<Real>& material, Real cos_incident) const {
+    PRISM_FORCE_INLINE Vec3<Real> reflection_weight(const Material<Real>& material, Real cos_incident) const {
         if (material.type != scene::MaterialType::conductor) return material.mirror;
         const Real fresnel =
             fresnel_conductor(std::max(cos_incident, Real(0)), material.refraction_index, material.absorption_index);
@@ -380,7 +381,7 @@ private:
     // `origins` holds for its side where rays leave by the error bound. spawn_origin depends on
     // the direction only through that side, so the ray is the one leaving_ray would give, bit
     // for bit. Inlined for stored_whole, as leaving_ray is.
-    [[gnu::always_inline]] Ray<Real> leaving(const SurfacePoint<Real>& point, const Vec3<Real>& normal,
+    PRISM_FORCE_INLINE Ray<Real> leaving(const SurfacePoint<Real>& point, const Vec3<Real>& normal,
                                              const Vec3<Real>& direction, Real time, SpawnOrigins& origins) const {
         if (settings_.ray_offset == RayOffset::error_bound) {
             const int side = geometry_.spawn_side(point, direction);
@@ -410,7 +411,7 @@ private:
     // One light's term of direct_lighting's sum, added to `color` where its shadow ray is not
     // blocked.
     template <class L>
-    [[gnu::always_inline]] void light_term(const L& light, const SurfacePoint<Real>& point, const Vec3<Real>& normal,
+    PRISM_FORCE_INLINE void light_term(const L& light, const SurfacePoint<Real>& point, const Vec3<Real>& normal,
                                            const Vec3<Real>& to_viewer, const Material<Real>& material, Random& random,
                                            SpawnOrigins& origins, Vec3<Real>& color) const {
         const Vec3<Real>& position = point.position;
@@ -498,7 +499,7 @@ private:
     // Field by field: a whole Ray copied into the batches' arrays was read back wider than its
     // parts had been written (a failed store forward, a fifth of hw1 simple_reflectance's
     // samples of point_lighting_batched).
-    [[gnu::always_inline]] void make_shadow_ray(Ray<Real>& made, const SurfacePoint<Real>& point, const Vec3<Real>& normal,
+    PRISM_FORCE_INLINE void make_shadow_ray(Ray<Real>& made, const SurfacePoint<Real>& point, const Vec3<Real>& normal,
                                                 const LightSample<Real>& sample, SpawnOrigins& origins) const {
         const Ray<Real> shadow = leaving(point, normal, sample.direction, point.time, origins);
         made.origin = shadow.origin;
@@ -511,7 +512,7 @@ private:
     }
 
     // One light's reflected radiance at a point its shadow ray found lit.
-    [[gnu::always_inline]] Vec3<Real> reflected(const Material<Real>& material, const Vec3<Real>& normal,
+    PRISM_FORCE_INLINE Vec3<Real> reflected(const Material<Real>& material, const Vec3<Real>& normal,
                                                 const Vec3<Real>& to_viewer, const LightSample<Real>& sample,
                                                 Real cos_light) const {
         if (material.brdf_given)

@@ -17,7 +17,12 @@
 #include <type_traits>
 #include <utility>
 
-#if !defined(PRISM_SIMD_SCALAR) && defined(__GLIBCXX__) && __has_include(<experimental/simd>)
+// Not under clang where AVX-512 is enabled: there libstdc++'s masks are bit masks, and clang 14
+// compiles `where(mask, b) = a` into wrong lanes (every width of float and double; select and
+// all built on it, seen as wrong images in the unit tests, test_simd_pack's select case).
+// There the Pack is the array form, as with PRISM_SIMD_SCALAR, and computes the same bits.
+#if !defined(PRISM_SIMD_SCALAR) && defined(__GLIBCXX__) && __has_include(<experimental/simd>) && \
+    !(defined(__clang__) && defined(__AVX512F__))
 #include <experimental/simd>
 #define PRISM_SIMD_STDX 1
 #endif
@@ -29,7 +34,8 @@
 
 // Every operation is forced inline: each is one instruction or two, and a call costs more (GCC
 // left the slab test's max_keep and min_keep out of line, 3.7% of a course primary profile).
-#if defined(__GNUC__) || defined(__clang__)
+// Not in a sanitized build, for the reason PRISM_FORCE_INLINE gives (math/force_inline.hpp).
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(PRISM_NO_FORCED_INLINE)
 #define PRISM_SIMD_INLINE [[gnu::always_inline]]
 #else
 #define PRISM_SIMD_INLINE

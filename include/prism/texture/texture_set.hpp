@@ -55,6 +55,7 @@
 //   cube) gives 39.1 and 50.0 dB, 10^-2 / NoiseScale 75.2 and 40.8 dB.
 #pragma once
 
+#include <prism/math/force_inline.hpp>
 #include <prism/geometry/hit.hpp>
 #include <prism/material/material.hpp>
 #include <prism/math/vector.hpp>
@@ -124,7 +125,7 @@ public:
     // A point without textures returns at once, inlined into the integrator: out of line, the
     // call alone (its frame set up for the texture lookups) was 3.3-3.9% of hw7 path_diffuse's
     // and path_glass's time, scenes with no texture at all.
-    [[gnu::always_inline]] std::optional<Vec3<Real>> apply(SurfacePoint<Real>& point, Material<Real>& material,
+    PRISM_FORCE_INLINE std::optional<Vec3<Real>> apply(SurfacePoint<Real>& point, Material<Real>& material,
                                                            const RayCone<Real>& cone = {}) const {
         if (point.textures.empty()) return {};
         return apply_textures(point, material, cone);
