@@ -29,10 +29,8 @@ if [[ $target != build ]] && { ! [[ "$seconds" =~ ^[0-9]+$ ]] || [[ "$seconds" -
   exit 2
 fi
 
-if ! command -v clang++-14 >/dev/null || ! ls /usr/lib/llvm-14/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then
-  echo "fuzz.sh: installing clang-14 and libclang-rt-14-dev (libFuzzer)" >&2
-  apt-get install -y --no-install-recommends clang-14 libclang-rt-14-dev zlib1g-dev >&2
-fi
+# clang 14, libFuzzer's runtime and zlib's headers, where missing.
+bash tools/install-dependencies.sh --with-fuzzers >&2
 
 build=build-fuzz
 if [[ ! -f $build/CMakeCache.txt ]]; then

@@ -8,7 +8,7 @@
 # - forced inlining is off (PRISM_NO_FORCED_INLINE), so each kernel is instrumented once;
 # - the target is x86-64-v3 (AVX2), not this machine's: under clang with AVX-512 the Pack is the
 #   array form (simd/pack.hpp), whose calls, uninlined and instrumented, took the unit tests
-#   2.6 times as long to run (260 s against 99 s); with AVX2 the Pack is libstdc++'s simd, as in
+#   twice as long to run (260 s against 133 s); with AVX2 the Pack is libstdc++'s simd, as in
 #   the Release build;
 # - ASan's use-after-scope check is off (it tripled the compile time of the template-heavy test
 #   files under GCC);
