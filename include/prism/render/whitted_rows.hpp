@@ -160,10 +160,10 @@ void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment>::shade_
     // simple_shading's instructions), and per light what that lighting draws.
     struct RowPoint {
         SurfacePoint<Real> point;
-        Vec3<Real> normal, color;
-        SpawnOrigins origins;
-        std::uint32_t lit;  // bit k: light k's shadow ray is made
-        bool front_face, inside_medium;
+        Vec3<Real> normal{0}, color{0};
+        SpawnOrigins origins{};
+        std::uint32_t lit = 0;  // bit k: light k's shadow ray is made
+        bool front_face = false, inside_medium = false;
     };
     Unconstructed<RowPoint, row_width> points;
     std::array<std::array<Vec3<Real>, row_width>, row_lights> directions, radiances;

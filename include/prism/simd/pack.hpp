@@ -248,8 +248,8 @@ PRISM_SIMD_INLINE inline Pack<T, N> min_keep(Pack<T, N> a, Pack<T, N> b) {
 template <class T, int N>
 PRISM_SIMD_INLINE inline Pack<T, N> sqrt(Pack<T, N> a) {
 #if defined(PRISM_SIMD_STDX)
-    using Native = typename Pack<T, N>::Native;
 #if defined(PRISM_SIMD_X86) && defined(__AVX512F__)
+    using Native = typename Pack<T, N>::Native;
     if constexpr (std::is_same_v<T, float> && requires(const Native& v) { static_cast<__m512>(v); }) {
         const __m512 x = static_cast<__m512>(a.native);
         return {Native(_mm512_mask_sqrt_ps(x, __mmask16(-1), x))};
