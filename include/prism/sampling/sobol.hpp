@@ -1,0 +1,177 @@
+// Owen-scrambled Sobol' points with the pixels in Morton order: the design of Ahmed and Wonka,
+// "Screen-Space Blue-Noise Diffusion of Monte Carlo Sampling Error via Hierarchical Ordering of
+// Pixels" (SIGGRAPH Asia 2020), as pbrt-v4's ZSobolSampler uses it (Pharr, Jakob and Humphreys,
+// 4th ed., sec. 8.7.7).
+//
+// Every dimension (or pair of dimensions) is a (0, 2)-sequence: the first two Sobol' dimensions,
+// each scrambled with its own seed. Sample i of pixel (x, y) is point (morton(x, y) << log2 spp)
+// + i of it, so the pixel's samples are one aligned block of the sequence, which is a (0, m, 2)-net
+// for 2^m samples: stratified in every elementary interval. Before it is used the index has its
+// base-4 digits shuffled, each by one of the 24 permutations of {0, 1, 2, 3} chosen by a hash of
+// the digits above it and of the dimension: neighbouring pixels (neighbours in Morton order) take
+// different parts of the sequence, and so their errors differ in the way blue noise does, while
+// each pixel's block stays a block. Dimensions are padded with independent scrambles rather than
+// taken from higher Sobol' dimensions, whose 2D projections are poorer.
+#pragma once
+
+#include <prism/sampling/sampler.hpp>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cstdint>
+
+namespace prism {
+
+namespace sampling {
+
+constexpr std::uint32_t reverse_bits(std::uint32_t v) {
+    v = ((v >> 1) & 0x55555555u) | ((v & 0x55555555u) << 1);
+    v = ((v >> 2) & 0x33333333u) | ((v & 0x33333333u) << 2);
+    v = ((v >> 4) & 0x0f0f0f0fu) | ((v & 0x0f0f0f0fu) << 4);
+    v = ((v >> 8) & 0x00ff00ffu) | ((v & 0x00ff00ffu) << 8);
+    return (v >> 16) | (v << 16);
+}
+
+// The first Sobol' dimension of point `index`, as 32 bits of a fraction: the van der Corput
+// sequence in base 2 (its generator matrix is the identity).
+constexpr std::uint32_t sobol_dimension0(std::uint32_t index) { return reverse_bits(index); }
+
+// The second: its generator matrix is Pascal's triangle mod 2, whose column k (the direction
+// number of index bit k) is column k-1 XOR itself shifted one place down.
+constexpr std::uint32_t sobol_dimension1(std::uint32_t index) {
+    std::uint32_t result = 0;
+    for (std::uint32_t direction = 0x80000000u; index != 0; index >>= 1, direction ^= direction >> 1)
+        if (index & 1) result ^= direction;
+    return result;
+}
+
+// A nested uniform (Owen) scramble of a 32-bit fraction by hashing (Burley, "Practical Hash-based
+// Owen Scrambling", JCGT 2020): on the bit-reversed value, additions and multiplications carry
+// only towards higher bits, so each digit of the fraction is flipped by a function of the digits
+// before it and the seed alone. That permutes the elementary intervals at every level, so a net
+// stays a net.
+constexpr std::uint32_t owen_scramble(std::uint32_t v, std::uint32_t seed) {
+    v = reverse_bits(v);
+    v ^= v * 0x3d20adeau;
+    v += seed;
+    v *= (seed >> 16) | 1u;
+    v ^= v * 0x05526c56u;
+    v ^= v * 0x53a22864u;
+    return reverse_bits(v);
+}
+
+// Morton order: x's bits in the even places, y's in the odd.
+constexpr std::uint64_t morton_2d(std::uint32_t x, std::uint32_t y) {
+    const auto spread = [](std::uint64_t v) {
+        v &= 0xffffffffULL;
+        v = (v | (v << 16)) & 0x0000ffff0000ffffULL;
+        v = (v | (v << 8)) & 0x00ff00ff00ff00ffULL;
+        v = (v | (v << 4)) & 0x0f0f0f0f0f0f0f0fULL;
+        v = (v | (v << 2)) & 0x3333333333333333ULL;
+        v = (v | (v << 1)) & 0x5555555555555555ULL;
+        return v;
+    };
+    return spread(x) | (spread(y) << 1);
+}
+
+// The 24 permutations of {0, 1, 2, 3}, in lexicographic order.
+constexpr std::array<std::array<std::uint8_t, 4>, 24> base4_permutations() {
+    std::array<std::array<std::uint8_t, 4>, 24> all{};
+    std::array<std::uint8_t, 4> p{0, 1, 2, 3};
+    for (auto& permutation : all) {
+        permutation = p;
+        std::next_permutation(p.begin(), p.end());
+    }
+    return all;
+}
+
+}  // namespace sampling
+
+class ZSobolSampler {
+public:
+    constexpr ZSobolSampler(std::uint64_t morton, int log2_samples, int base4_digits, std::uint64_t seed)
+        : morton_(morton), log2_samples_(log2_samples), base4_digits_(base4_digits), seed_(seed) {}
+
+    constexpr void start_sample(int index) {
+        index_ = (morton_ << log2_samples_) | std::uint64_t(std::uint32_t(index));
+        dimension_ = 0;
+    }
+
+    template <Scalar Real>
+    constexpr Real uniform() {
+        const std::uint64_t key = sampling::hash_key(std::uint64_t(dimension_), seed_, 1);
+        const std::uint32_t bits = sampling::owen_scramble(sampling::sobol_dimension0(point_index()), std::uint32_t(key));
+        ++dimension_;
+        return sampling::unit_from_bits<Real>(bits);
+    }
+
+    template <Scalar Real>
+    constexpr Vec2<Real> uniform2() {
+        const std::uint64_t key = sampling::hash_key(std::uint64_t(dimension_), seed_, 2);
+        const std::uint32_t index = point_index();
+        const std::uint32_t x = sampling::owen_scramble(sampling::sobol_dimension0(index), std::uint32_t(key));
+        const std::uint32_t y = sampling::owen_scramble(sampling::sobol_dimension1(index), std::uint32_t(key >> 32));
+        dimension_ += 2;
+        return {sampling::unit_from_bits<Real>(x), sampling::unit_from_bits<Real>(y)};
+    }
+
+    template <Scalar Real>
+    constexpr void skip(int count) {
+        dimension_ += count;
+    }
+
+    // The Sobol' index the current dimension takes for the current sample: the sample's index
+    // with its base-4 digits shuffled, from the top, each by a permutation chosen by a hash of
+    // the (original) digits above it, the dimension and the seed. With an odd log2 of the
+    // sample count the lowest digit is base 2, flipped by a hash bit. Only the low 32 bits reach
+    // a 32-bit fraction (sobol_dimension0/1), as in any 32-bit Sobol' generator.
+    constexpr std::uint32_t point_index() const {
+        constexpr auto permutations = sampling::base4_permutations();
+        const bool odd = (log2_samples_ & 1) != 0;
+        const std::uint64_t salt = sampling::hash_key(std::uint64_t(dimension_), seed_, 3);
+        std::uint64_t shuffled = 0;
+        for (int digit = base4_digits_ - 1; digit >= (odd ? 1 : 0); --digit) {
+            const int shift = 2 * digit - (odd ? 1 : 0);
+            const std::uint64_t above = shift + 2 >= 64 ? 0 : index_ >> (shift + 2);
+            const std::uint64_t chosen = mix_bits(above ^ salt) >> 40;
+            const auto& permutation = permutations[std::size_t(chosen % 24)];
+            shuffled |= std::uint64_t(permutation[(index_ >> shift) & 3]) << shift;
+        }
+        if (odd) shuffled |= (index_ & 1) ^ (mix_bits((index_ >> 1) ^ salt) >> 63);
+        return std::uint32_t(shuffled);
+    }
+
+private:
+    std::uint64_t morton_;
+    int log2_samples_, base4_digits_;
+    std::uint64_t seed_;
+    std::uint64_t index_ = 0;
+    int dimension_ = 0;
+};
+
+// A render's ZSobol pattern: its sample count rounded up to a power of two for the index (the
+// first samples_per_pixel of each pixel's block are used), and enough base-4 digits for the
+// larger side of the image rounded up to a power of two.
+class ZSobolPattern {
+public:
+    ZSobolPattern(int samples_per_pixel, int width, int height, std::uint64_t seed)
+        : samples_per_pixel_(std::max(1, samples_per_pixel)), seed_(seed) {
+        log2_samples_ = std::bit_width(std::uint32_t(samples_per_pixel_ - 1));
+        const int side = std::max({1, width, height});
+        const int log2_side = std::bit_width(std::uint32_t(side - 1));
+        base4_digits_ = log2_side + (log2_samples_ + 1) / 2;
+    }
+
+    ZSobolSampler for_pixel(int x, int y) const {
+        return ZSobolSampler(sampling::morton_2d(std::uint32_t(x), std::uint32_t(y)), log2_samples_, base4_digits_, seed_);
+    }
+    int samples_per_pixel() const { return samples_per_pixel_; }
+
+private:
+    int samples_per_pixel_;
+    std::uint64_t seed_;
+    int log2_samples_ = 0, base4_digits_ = 0;
+};
+
+}  // namespace prism

@@ -1,0 +1,258 @@
+// The samplers of sampling/sampler.hpp, for float and double: each keeps the promise of its
+// construction (ZSobol: Sobol' points against published values, every pixel's samples a
+// (0, m, 2)-net in every pair of dimensions; Stratified: one sample per stratum of every
+// dimension and per cell of every pair), draws the same numbers for the same (pixel, sample,
+// dimension) whatever was drawn before, and uses no dimension twice (no correlation between the
+// dimensions two bounces take).
+#include <prism/sampling/sampler.hpp>
+#include <prism/sampling/sobol.hpp>
+#include <prism/sampling/stratified.hpp>
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <set>
+#include <utility>
+#include <vector>
+
+namespace {
+
+namespace samplers_test {
+
+using prism::Vec2;
+
+// Sample `sample` of a pixel's sampler: `skipped` dimensions passed, then one pair.
+template <class Real, class Sampler>
+Vec2<Real> pair_at(Sampler sampler, int sample, int skipped) {
+    sampler.start_sample(sample);
+    sampler.template skip<Real>(skipped);
+    return sampler.template uniform2<Real>();
+}
+template <class Real, class Sampler>
+Real single_at(Sampler sampler, int sample, int skipped) {
+    sampler.start_sample(sample);
+    sampler.template skip<Real>(skipped);
+    return sampler.template uniform<Real>();
+}
+
+// Whether n = 2^m points form a (0, m, 2)-net: every partition of the unit square into 2^m
+// equal boxes 2^a wide and 2^(m-a) high holds one point in each box.
+template <class Real>
+bool is_net(const std::vector<Vec2<Real>>& points) {
+    const int n = int(points.size());
+    int m = 0;
+    while ((1 << m) < n) ++m;
+    for (int a = 0; a <= m; ++a) {
+        const int columns = 1 << a, rows = 1 << (m - a);
+        std::set<std::pair<int, int>> boxes;
+        for (const auto& p : points) boxes.insert({int(p.x * columns), int(p.y * rows)});
+        if (int(boxes.size()) != n) return false;
+    }
+    return true;
+}
+
+// Whether the values fall one in each of the n strata [k/n, (k+1)/n).
+template <class Real>
+bool one_per_stratum(const std::vector<Real>& values) {
+    std::set<int> strata;
+    for (Real v : values) strata.insert(int(std::floor(double(v) * double(values.size()))));
+    return strata.size() == values.size() && *strata.begin() >= 0 && *strata.rbegin() < int(values.size());
+}
+
+// Pearson's correlation of two equally long lists.
+double correlation(const std::vector<double>& a, const std::vector<double>& b) {
+    const double n = double(a.size());
+    double ma = 0, mb = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) ma += a[i] / n, mb += b[i] / n;
+    double ab = 0, aa = 0, bb = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        ab += (a[i] - ma) * (b[i] - mb);
+        aa += (a[i] - ma) * (a[i] - ma);
+        bb += (b[i] - mb) * (b[i] - mb);
+    }
+    return ab / std::sqrt(aa * bb);
+}
+
+// Over 32 x 32 pixels and `samples` samples each, drawn as a render draws them (one sampler a
+// pixel, its samples in order), the correlation between the number of dimension `d1` and of
+// `d2` > d1 (as two bounces draw them), and whether every number is in [0, 1).
+template <class Real, class Pattern>
+std::pair<double, bool> dimension_correlation(const Pattern& pattern, int samples, int d1, int d2) {
+    std::vector<double> a, b;
+    bool in_range = true;
+    for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x) {
+            auto sampler = pattern.for_pixel(x, y);
+            for (int s = 0; s < samples; ++s) {
+                sampler.start_sample(s);
+                sampler.template skip<Real>(d1);
+                const Real u = sampler.template uniform<Real>();
+                sampler.template skip<Real>(d2 - d1 - 1);
+                const Real v = sampler.template uniform<Real>();
+                in_range = in_range && u >= 0 && u < 1 && v >= 0 && v < 1;
+                a.push_back(double(u));
+                b.push_back(double(v));
+            }
+        }
+    return {correlation(a, b), in_range};
+}
+
+}  // namespace samplers_test
+
+using namespace samplers_test;
+
+}  // namespace
+
+static_assert(prism::PixelSampler<prism::IndependentSampler, float>);
+static_assert(prism::PixelSampler<prism::ZSobolSampler, double>);
+static_assert(prism::PixelSampler<prism::StratifiedSampler, float>);
+static_assert(prism::SamplerPattern<prism::IndependentPattern, float>);
+static_assert(prism::SamplerPattern<prism::ZSobolPattern, float>);
+static_assert(prism::SamplerPattern<prism::StratifiedPattern, double>);
+
+TEST_CASE("Samplers: Sobol' dimensions 0 and 1 give the published first points") {
+    // The unscrambled two-dimensional Sobol' points 0-15 in Gray-code order (Bratley and Fox's
+    // ordering, as scipy.stats.qmc.Sobol(d=2, scramble=False) lists them): point i of that
+    // order is point i ^ (i >> 1) of the natural one.
+    const double published[16][2] = {
+        {0, 0},           {0.5, 0.5},       {0.75, 0.25},     {0.25, 0.75},     {0.375, 0.375},   {0.875, 0.875},
+        {0.625, 0.125},   {0.125, 0.625},   {0.1875, 0.3125}, {0.6875, 0.8125}, {0.9375, 0.0625}, {0.4375, 0.5625},
+        {0.3125, 0.1875}, {0.8125, 0.6875}, {0.5625, 0.4375}, {0.0625, 0.9375}};
+    for (std::uint32_t i = 0; i < 16; ++i) {
+        const std::uint32_t natural = i ^ (i >> 1);
+        CAPTURE(i);
+        CHECK(prism::sampling::sobol_dimension0(natural) * 0x1p-32 == published[i][0]);
+        CHECK(prism::sampling::sobol_dimension1(natural) * 0x1p-32 == published[i][1]);
+    }
+    // Owen scrambling permutes elementary intervals: the first 2^m points stay a net.
+    std::vector<Vec2<double>> scrambled;
+    for (std::uint32_t i = 0; i < 256; ++i)
+        scrambled.push_back({prism::sampling::owen_scramble(prism::sampling::sobol_dimension0(i), 0x1234567u) * 0x1p-32,
+                             prism::sampling::owen_scramble(prism::sampling::sobol_dimension1(i), 0x89abcdefu) * 0x1p-32});
+    CHECK(is_net(scrambled));
+    CHECK(scrambled[1].x != 0.5);  // scrambled at all
+}
+
+TEST_CASE_TEMPLATE("Samplers: ZSobol makes each pixel's samples a (0, m, 2)-net in every pair of dimensions", Real, float,
+                   double) {
+    for (const int samples : {4, 8, 16, 32, 64}) {
+        const prism::ZSobolPattern pattern(samples, 640, 480, 7);
+        for (const std::pair<int, int>& pixel : {std::pair{0, 0}, std::pair{1, 0}, std::pair{313, 207}, std::pair{639, 479}}) {
+            const int x = pixel.first, y = pixel.second;  // named, not bound: doctest's CAPTURE takes them
+            for (int dimension = 0; dimension < 12; dimension += 2) {
+                std::vector<Vec2<Real>> points;
+                std::vector<Real> singles;
+                for (int s = 0; s < samples; ++s) {
+                    points.push_back(pair_at<Real>(pattern.for_pixel(x, y), s, dimension));
+                    singles.push_back(single_at<Real>(pattern.for_pixel(x, y), s, dimension));
+                }
+                CAPTURE(samples);
+                CAPTURE(x);
+                CAPTURE(y);
+                CAPTURE(dimension);
+                CHECK(is_net(points));
+                CHECK(one_per_stratum(singles));
+            }
+        }
+    }
+}
+
+TEST_CASE_TEMPLATE("Samplers: Stratified puts one sample in each stratum of every dimension and each cell of every pair",
+                   Real, float, double) {
+    for (const int samples : {1, 5, 9, 12, 16, 30}) {
+        const prism::StratifiedPattern pattern(samples, 11);
+        int columns = 1;
+        while (columns * columns < samples) ++columns;
+        const int rows = (samples + columns - 1) / columns;
+        for (const std::pair<int, int>& pixel : {std::pair{0, 0}, std::pair{5, 3}}) {
+            const int x = pixel.first, y = pixel.second;
+            for (int dimension = 0; dimension < 10; dimension += 2) {
+                std::vector<Real> singles, xs, ys;
+                std::set<std::pair<int, int>> cells;
+                std::set<int> x_strata, y_strata;
+                for (int s = 0; s < samples; ++s) {
+                    singles.push_back(single_at<Real>(pattern.for_pixel(x, y), s, dimension));
+                    const Vec2<Real> p = pair_at<Real>(pattern.for_pixel(x, y), s, dimension);
+                    CHECK((p.x >= 0 && p.x < 1 && p.y >= 0 && p.y < 1));
+                    cells.insert({int(p.x * columns), int(p.y * rows)});
+                    x_strata.insert(int(double(p.x) * columns * rows));
+                    y_strata.insert(int(double(p.y) * columns * rows));
+                }
+                CAPTURE(samples);
+                CAPTURE(dimension);
+                CHECK(one_per_stratum(singles));
+                CHECK(int(cells.size()) == samples);
+                CHECK(int(x_strata.size()) == samples);  // each axis alone: m k strata, one per sample
+                CHECK(int(y_strata.size()) == samples);
+            }
+        }
+    }
+}
+
+TEST_CASE_TEMPLATE("Samplers: a sample's numbers depend on its pixel, index and dimension, not on what was drawn before",
+                   Real, float, double) {
+    const prism::ZSobolPattern sobol(16, 64, 64, 3);
+    const prism::StratifiedPattern stratified(16, 3);
+    const auto check = [](const auto& pattern) {
+        auto a = pattern.for_pixel(9, 4);
+        auto b = pattern.for_pixel(9, 4);
+        // a draws sample 3 after samples 0-2 and other draws; b draws sample 3 fresh.
+        for (int s = 0; s < 3; ++s) {
+            a.start_sample(s);
+            for (int k = 0; k < 5; ++k) (void)a.template uniform2<Real>();
+        }
+        a.start_sample(3);
+        b.start_sample(3);
+        for (int k = 0; k < 8; ++k) {
+            CHECK(a.template uniform<Real>() == b.template uniform<Real>());
+            const Vec2<Real> pa = a.template uniform2<Real>(), pb = b.template uniform2<Real>();
+            CHECK(pa == pb);
+        }
+        // skip(n) passes exactly n dimensions.
+        auto c = pattern.for_pixel(9, 4), d = pattern.for_pixel(9, 4);
+        c.start_sample(5);
+        d.start_sample(5);
+        c.template skip<Real>(3);
+        (void)d.template uniform<Real>();
+        (void)d.template uniform2<Real>();
+        CHECK(c.template uniform<Real>() == d.template uniform<Real>());
+        // Neighbouring pixels draw other numbers.
+        CHECK(single_at<Real>(pattern.for_pixel(9, 4), 0, 0) != single_at<Real>(pattern.for_pixel(10, 4), 0, 0));
+    };
+    check(sobol);
+    check(stratified);
+}
+
+TEST_CASE_TEMPLATE("Samplers: Independent is the pixel's stream, drawn in order across its samples", Real, float, double) {
+    const prism::IndependentPattern pattern(4, 21);
+    auto sampler = pattern.for_pixel(7, 2);
+    prism::Random stream = prism::Random::for_pixel(7, 2, 21);
+    for (int s = 0; s < 4; ++s) {
+        sampler.start_sample(s);
+        CHECK(sampler.template uniform<Real>() == stream.uniform<Real>());
+        CHECK(sampler.template uniform2<Real>() == stream.uniform2<Real>());
+        sampler.template skip<Real>(3);
+        stream.skip<Real>(3);
+    }
+}
+
+TEST_CASE_TEMPLATE("Samplers: no dimension is reused: two bounces' dimensions are uncorrelated", Real, float, double) {
+    // 32 x 32 pixels x 16 samples: 16,384 pairs, so a correlation's standard error is about
+    // 0.008 for independent numbers; 0.05 is six of them. Dimensions 4 and 6, 5 and 9, and 0 and
+    // 12 stand for one bounce's numbers against the next's.
+    const prism::ZSobolPattern sobol(16, 32, 32, 5);
+    const prism::StratifiedPattern stratified(16, 5);
+    const prism::IndependentPattern independent(16, 5);
+    for (const std::pair<int, int>& dimensions : {std::pair{4, 6}, std::pair{5, 9}, std::pair{0, 12}}) {
+        const int d1 = dimensions.first, d2 = dimensions.second;
+        CAPTURE(d1);
+        CAPTURE(d2);
+        for (const auto& [r, in_range] : {dimension_correlation<Real>(sobol, 16, d1, d2),
+                                          dimension_correlation<Real>(stratified, 16, d1, d2),
+                                          dimension_correlation<Real>(independent, 16, d1, d2)}) {
+            CHECK(std::abs(r) < 0.05);
+            CHECK(in_range);
+        }
+    }
+}
