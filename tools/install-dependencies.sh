@@ -4,8 +4,8 @@
 # tools/chart.sh needs to turn its SVG into a PNG (rsvg-convert and a font); --with-browser adds
 # Debian's Chromium, in which the test report/opens_in_chromium loads prism-suite's HTML report
 # (skipped without it); --with-sanitizers adds clang 14 and its sanitizer runtimes, which build
-# tools/sanitize.sh's instrumented tests, and Ninja, which schedules that build; --with-fuzzers adds those and zlib's headers for the
-# libFuzzer harnesses (tools/fuzz.sh).
+# tools/sanitize.sh's instrumented tests, and Ninja, which schedules that build; --with-fuzzers
+# adds clang, its runtimes and zlib's headers for the libFuzzer harnesses (tools/fuzz.sh).
 set -euo pipefail
 packages=(build-essential cmake pkg-config libglm-dev libtinyexr-dev libstb-dev nlohmann-json3-dev
           libpugixml-dev libtbb-dev doctest-dev libbenchmark-dev)

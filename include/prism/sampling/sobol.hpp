@@ -121,6 +121,7 @@ public:
         dimension_ += count;
     }
 
+private:
     // The Sobol' index the current dimension takes for the current sample: the sample's index
     // with its base-4 digits shuffled, from the top, each by a permutation chosen by a hash of
     // the (original) digits above it, the dimension and the seed. With an odd log2 of the
@@ -142,7 +143,6 @@ public:
         return std::uint32_t(shuffled);
     }
 
-private:
     std::uint64_t morton_;
     int log2_samples_, base4_digits_;
     std::uint64_t seed_;

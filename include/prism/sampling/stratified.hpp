@@ -32,7 +32,7 @@ constexpr std::uint32_t permute_index(std::uint32_t i, std::uint32_t n, std::uin
     do {
         for (int round = 0; round < 2; ++round) {
             i = (i ^ (round ? k1 : k0)) & mask;
-            i = (i * (0x9e3779b9u | 1u)) & mask;
+            i = (i * 0x9e3779b9u) & mask;  // odd
             i ^= i >> ((bits + 1) / 2);
             i = (i + (round ? k0 >> 7 : k1 >> 9)) & mask;
             i = (i * (((round ? k1 : k0) >> 3) | 1u)) & mask;
