@@ -70,7 +70,7 @@ using RenderFunction = std::function<prism::Image(const prism::scene::Camera&, i
 template <class Real, class Intersector, class Acceleration = prism::Bvh<Intersector>>
 RenderFunction build_renderer(const prism::scene::Scene& scene, prism::RayOffset offset) {
     using Config = prism::Config<Real, Acceleration, prism::Lights<prism::PointLight>>;
-    auto renderer = std::make_shared<const prism::Renderer<Config>>(scene, prism::RendererSettings{prism::BackfaceCulling::none, offset, 0});
+    auto renderer = std::make_shared<const prism::Renderer<Config>>(scene, prism::RendererSettings{prism::BackfaceCulling::none, offset, 0, {}});
     return [renderer](const prism::scene::Camera& camera, int width, int height) {
         return renderer->render(camera, width, height);
     };

@@ -4,7 +4,9 @@
 // dimension and per cell of every pair), draws the same numbers for the same (pixel, sample,
 // dimension) whatever was drawn before, and uses no dimension twice (no correlation between the
 // dimensions two bounces take).
+#include <prism/render/renderer.hpp>
 #include <prism/sampling/sampler.hpp>
+#include <prism/sampling/sampler_choice.hpp>
 #include <prism/sampling/sobol.hpp>
 #include <prism/sampling/stratified.hpp>
 
@@ -13,6 +15,7 @@
 #include <cmath>
 #include <cstdint>
 #include <set>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -301,4 +304,122 @@ TEST_CASE_TEMPLATE("Samplers: at 16 samples a pixel, stratified and ZSobol estim
     CHECK(sobol.first < 0.7 * independent.first);
     CHECK(stratified.second < 0.3 * independent.second);
     CHECK(sobol.second < 0.3 * independent.second);
+}
+
+TEST_CASE_TEMPLATE("Samplers: the run-time choice draws what the chosen sampler draws, bit for bit", Real, float, double) {
+    static_assert(prism::PixelSampler<prism::ChosenSampler, Real>);
+    static_assert(prism::SamplerPattern<prism::ChosenPattern, Real>);
+    const auto same_draws = [](auto chosen, auto alone) {
+        int differ = 0;
+        for (int s = 0; s < 6; ++s) {
+            chosen.start_sample(s);
+            alone.start_sample(s);
+            for (int d = 0; d < 5; ++d) {
+                differ += chosen.template uniform<Real>() != alone.template uniform<Real>();
+                const prism::Vec2<Real> a = chosen.template uniform2<Real>(), b = alone.template uniform2<Real>();
+                differ += a != b;
+                chosen.template skip<Real>(d);
+                alone.template skip<Real>(d);
+                differ += chosen.dimension() != alone.dimension();
+            }
+            chosen.seek(40);
+            alone.seek(40);
+            differ += chosen.template uniform<Real>() != alone.template uniform<Real>();
+        }
+        return differ;
+    };
+    const prism::SamplingLayout layout{6, 20, 10, 17, {}};
+    for (const auto& [x, y] : {std::pair{0, 0}, std::pair{3, 9}, std::pair{19, 4}}) {
+        prism::SamplingLayout chosen = layout;
+        chosen.kind = prism::SamplerKind::independent;
+        CHECK(same_draws(prism::ChosenPattern(chosen).for_pixel(x, y), prism::IndependentPattern(6, 17).for_pixel(x, y)) == 0);
+        chosen.kind = prism::SamplerKind::stratified;
+        CHECK(same_draws(prism::ChosenPattern(chosen).for_pixel(x, y), prism::StratifiedPattern(6, 17).for_pixel(x, y)) == 0);
+        chosen.kind = prism::SamplerKind::sobol;
+        CHECK(same_draws(prism::ChosenPattern(chosen).for_pixel(x, y), prism::ZSobolPattern(6, 20, 10, 17).for_pixel(x, y)) == 0);
+        // Left open, the kind is default_sampler.
+        prism::SamplingLayout defaulted = layout;
+        defaulted.kind = prism::default_sampler;
+        CHECK(same_draws(prism::ChosenPattern(layout).for_pixel(x, y), prism::ChosenPattern(defaulted).for_pixel(x, y)) == 0);
+    }
+    // A stream ignores seek and has no dimensions; the others go where they are sent.
+    prism::IndependentSampler stream = prism::IndependentPattern(1, 3).for_pixel(2, 2), unmoved = stream;
+    stream.seek(12);
+    CHECK(stream.dimension() == 0);
+    CHECK(stream.template uniform<Real>() == unmoved.template uniform<Real>());
+    prism::ZSobolSampler sobol = prism::ZSobolPattern(4, 4, 4, 3).for_pixel(1, 1), walked = sobol;
+    sobol.start_sample(2);
+    walked.start_sample(2);
+    sobol.seek(9);
+    walked.template skip<Real>(9);
+    CHECK(sobol.dimension() == 9);
+    CHECK(sobol.template uniform2<Real>() == walked.template uniform2<Real>());
+}
+
+TEST_CASE("Samplers: names parse both ways, and a fixed pattern refuses another kind") {
+    for (const prism::SamplerKind kind :
+         {prism::SamplerKind::independent, prism::SamplerKind::stratified, prism::SamplerKind::sobol})
+        CHECK(prism::parse_sampler(prism::sampler_name(kind)) == kind);
+    CHECK_FALSE(prism::parse_sampler("halton").has_value());
+    CHECK_FALSE(prism::parse_sampler("").has_value());
+    CHECK_FALSE(prism::parse_sampler("Sobol").has_value());
+    prism::SamplingLayout layout{4, 8, 8, 0, prism::SamplerKind::sobol};
+    CHECK_NOTHROW(prism::make_pattern<prism::ZSobolPattern>(layout));
+    CHECK_NOTHROW(prism::make_pattern<prism::ChosenPattern>(layout));
+    CHECK_THROWS_WITH_AS(prism::make_pattern<prism::StratifiedPattern>(layout),
+                         "the sampler sobol was asked for, and this renderer was compiled with stratified only",
+                         std::invalid_argument);
+    layout.kind.reset();
+    CHECK_NOTHROW(prism::make_pattern<prism::StratifiedPattern>(layout));
+    CHECK(prism::streamed(prism::make_pattern<prism::IndependentPattern>(layout)));
+    CHECK_FALSE(prism::streamed(prism::make_pattern<prism::StratifiedPattern>(layout)));
+    layout.kind = prism::SamplerKind::independent;
+    CHECK(prism::streamed(prism::make_pattern<prism::ChosenPattern>(layout)));
+    layout.kind = prism::SamplerKind::stratified;
+    CHECK_FALSE(prism::streamed(prism::make_pattern<prism::ChosenPattern>(layout)));
+}
+
+TEST_CASE_TEMPLATE("Samplers: a Config that fixes its sampler renders what the run-time choice of it renders", Real, float,
+                   double) {
+    // A rough mirror floor under a point light and four samples a pixel: every sample draws
+    // (the camera's dimensions, the glossy lobe's), so a sampler that differed would show.
+    namespace scene = prism::scene;
+    scene::Scene world;
+    world.max_recursion_depth = 2;
+    scene::Material matte;
+    matte.diffuse = {0.7, 0.4, 0.2};
+    scene::Material rough;
+    rough.type = scene::MaterialType::mirror;
+    rough.mirror = {0.8, 0.8, 0.8};
+    rough.roughness = 0.3;
+    world.materials = {matte, rough};
+    world.spheres.push_back({"ball", 0, {0, 0, -3}, 0.8, glm::dmat4(1.0)});
+    world.planes.push_back({"floor", 1, {0, -0.8, 0}, {0, 1, 0}, glm::dmat4(1.0)});
+    world.point_lights.push_back({"bulb", {1, 3, -1}, {30, 30, 30}});
+    scene::Camera camera;
+    camera.gaze = {0, -0.2, -1};
+    camera.up = {0, 1, 0};
+    camera.near_left = camera.near_bottom = -0.5;
+    camera.near_right = camera.near_top = 0.5;
+    camera.width = camera.height = 12;
+    camera.num_samples = 4;
+    camera.image_name = "out.png";
+    world.cameras.push_back(camera);
+    using Chosen = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::Lights<prism::PointLight>>;
+    using Fixed = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::Lights<prism::PointLight>, prism::Features{},
+                                prism::Whitted, prism::ZSobolPattern>;
+    const prism::RendererSettings sobol{prism::BackfaceCulling::triangles, prism::RayOffset::scene_epsilon, 5,
+                                        prism::SamplerKind::sobol};
+    const prism::Image chosen = prism::Renderer<Chosen>(world, sobol).render(world.cameras[0]);
+    const prism::Image fixed = prism::Renderer<Fixed>(world, sobol).render(world.cameras[0]);
+    CHECK(chosen.pixels == fixed.pixels);
+    // Left open, the fixed Config renders its own sampler; another kind is refused.
+    prism::RendererSettings open = sobol;
+    open.sampler.reset();
+    CHECK(prism::Renderer<Fixed>(world, open).render(world.cameras[0]).pixels == fixed.pixels);
+    prism::RendererSettings other = sobol;
+    other.sampler = prism::SamplerKind::independent;
+    CHECK_THROWS_AS(prism::Renderer<Fixed>(world, other), std::invalid_argument);
+    // And the sampler matters: the independent image differs.
+    CHECK(prism::Renderer<Chosen>(world, other).render(world.cameras[0]).pixels != fixed.pixels);
 }

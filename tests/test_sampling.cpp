@@ -480,24 +480,31 @@ TEST_CASE_TEMPLATE("Renderer: a pixel's samples lit side by side (radiances_at) 
         if (indexed) world.meshes.push_back(tent);
         for (const prism::RayOffset offset : {prism::RayOffset::scene_epsilon, prism::RayOffset::error_bound}) {
             CAPTURE(int(offset));
-            for (const int count : {5, 16, 40}) {
+            for (const auto& [count, kind] : {std::pair{5, prism::SamplerKind::independent},
+                                              std::pair{16, prism::SamplerKind::independent},
+                                              std::pair{40, prism::SamplerKind::independent},
+                                              std::pair{16, prism::SamplerKind::stratified},
+                                              std::pair{40, prism::SamplerKind::sobol}}) {
                 CAPTURE(count);
+                CAPTURE(prism::sampler_name(kind));
                 world.cameras[0].num_samples = count;
-                const prism::RendererSettings settings{prism::BackfaceCulling::triangles, offset, 7};
+                const prism::RendererSettings settings{prism::BackfaceCulling::triangles, offset, 7, kind};
                 const Whole renderer(world, settings);
                 const prism::Image image = renderer.render(world.cameras[0]);
                 const prism_test::RendererParts<Whole> parts(world, settings);
                 const auto& integrator = parts.integrator;
                 REQUIRE(integrator.prelights());
                 const prism::ThinLensCamera<Real> lens(world.cameras[0], camera.width, camera.height);
+                const auto pattern = prism::make_pattern<typename Whole::Pattern>(
+                    {count, camera.width, camera.height, settings.seed, settings.sampler});
                 int mismatches = 0, distinct = 0;
                 std::set<std::array<float, 3>> colours;
                 for (int y = 0; y < camera.height; ++y)
                     for (int x = 0; x < camera.width; ++x) {
                         const glm::vec3 expected = prism_test::one_by_one_pixel(
-                            integrator, lens, world.cameras[0], count, x, y, settings.seed,
-                            [](prism::Random& random, const prism::Vec2<Real>& pixel_uv, Real spread) {
-                                return typename Whole::Integrator::CameraPath{random, pixel_uv, spread};
+                            integrator, lens, world.cameras[0], pattern, count, x, y, settings.seed,
+                            [](auto& sampler, const prism::Vec2<Real>& pixel_uv, Real spread) {
+                                return typename Whole::Integrator::CameraPath{sampler, pixel_uv, spread};
                             });
                         mismatches += std::memcmp(&expected, &image(x, y), sizeof expected) != 0;
                         colours.insert({expected.r, expected.g, expected.b});

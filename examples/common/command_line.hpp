@@ -1,6 +1,7 @@
 // What the example programs share on their command lines: a usage error is one line on stderr
 // and exit status 2, numbers parse whole or not at all, and every program that renders takes the
-// same --threads, --precision, --scale, --samples, --max-samples, --ray-offset and --seed with the same checks.
+// same --threads, --precision, --scale, --samples, --max-samples, --ray-offset, --seed and --sampler with the
+// same checks.
 #pragma once
 
 #include <prism/io/limits.hpp>
@@ -77,6 +78,10 @@ public:
             options.backface_culling = chosen;
         } else if (option == "--seed") {
             options.seed = number<std::uint64_t>(option, next_value());
+        } else if (option == "--sampler") {
+            const std::string_view name = next_value();
+            options.sampler = parse_sampler(name);
+            if (!options.sampler) usage_error("--sampler must be independent, stratified or sobol");
         } else {
             return false;
         }

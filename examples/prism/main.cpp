@@ -54,6 +54,10 @@ options:
                        epsilon, unless it is below 64 ulps of the scene's largest coordinate
   --seed N             selects the pixels' random streams (default 0); any thread count gives
                        the same image for the same seed
+  --sampler S          independent | stratified | sobol: where each sample's numbers come from
+                       (the pixel's random stream; every dimension stratified across the
+                       pixel's samples; Owen-scrambled Sobol' points in Morton order, pbrt-v4's
+                       ZSobol). Default: independent
   --accelerator A      prism (its own BVH; the default) or embree: Embree 3 finds the hits,
                        prism tests the triangle it finds and shades (float; only when built
                        with libembree-dev)

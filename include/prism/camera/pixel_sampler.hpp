@@ -63,6 +63,23 @@ CameraSample<Real> centre_sample(Random& random) {
     return sample;
 }
 
+// The camera's dimensions of a sample drawn from a pixel sampler that is not a stream
+// (sampling/sampler.hpp): the position in the pixel (0-1; the centre in a one-sample pixel, as
+// centre_sample, its pair skipped), the lens point (2-3) and the shutter instant (4). The
+// sampler stratifies each across the pixel's samples itself. The integrator draws from
+// camera_dimensions on.
+inline constexpr int camera_dimensions = 5;
+
+template <Scalar Real, class Sampler>
+CameraSample<Real> camera_sample(Sampler& sampler, bool centred) {
+    CameraSample<Real> sample;
+    if (centred) sampler.template skip<Real>(2);
+    else sample.pixel = sampler.template uniform2<Real>();
+    sample.lens = sampler.template uniform2<Real>();
+    sample.time = sampler.template uniform<Real>();
+    return sample;
+}
+
 // Fills `samples` with the pixel's `count` camera samples from its random stream. `scratch`
 // avoids reallocating per pixel.
 template <Scalar Real>

@@ -1,6 +1,7 @@
 // A renderer's compile-time configuration: scalar type, acceleration policy (index and triangle
 // intersector), light types, the shading features that cost work on every ray, and the
-// integrator. `Renderer<Config<float, Bvh<Watertight>, Lights<PointLight>>>` is a type that
+// integrator, and the sampler (sampling/sampler_choice.hpp: one fixed pattern, or ChosenPattern,
+// chosen at run time). `Renderer<Config<float, Bvh<Watertight>, Lights<PointLight>>>` is a type that
 // contains exactly the code those choices need: without `Features::textures` no hit looks up a
 // texture, without `Features::motion_blur` no ray is moved in time. `covers(needs)` states
 // which scenes a Config can render (scene/needs.hpp), so a dispatcher picks among shipped
@@ -12,6 +13,7 @@
 #include <prism/light/point_light.hpp>
 #include <prism/render/integrator.hpp>
 #include <prism/render/whitted_integrator.hpp>
+#include <prism/sampling/sampler_choice.hpp>
 #include <prism/scene/needs.hpp>
 
 namespace prism {
@@ -25,13 +27,14 @@ struct Features {
 };
 
 template <Scalar RealT, class AccelerationT = Bvh<Watertight>, class LightTypesT = Lights<PointLight>,
-          Features FeaturesV = Features{}, class IntegratorT = Whitted>
-    requires AccelerationPolicy<AccelerationT, RealT> && IntegratorPolicy<IntegratorT>
+          Features FeaturesV = Features{}, class IntegratorT = Whitted, class SamplerT = ChosenPattern>
+    requires AccelerationPolicy<AccelerationT, RealT> && IntegratorPolicy<IntegratorT> && SamplerPattern<SamplerT, RealT>
 struct Config {
     using Real = RealT;
     using Acceleration = AccelerationT;
     using LightTypes = LightTypesT;
     using IntegratorPolicy = IntegratorT;
+    using SamplerPolicy = SamplerT;
     static constexpr Features features = FeaturesV;
 
     // What this configuration renders, stated as the needs it meets: every light kind of its set

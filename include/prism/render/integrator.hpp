@@ -1,5 +1,5 @@
 // What a renderer asks of its integrator: the radiance arriving along a camera ray, with the
-// per-pixel state (`CameraPath`: the pixel's random stream and what textures need) the
+// per-pixel state (`CameraPath`: the pixel's sampler and what textures need) the
 // integrator defines. An integrator policy (`Whitted`, and the path tracer beside it) names the
 // integrator type a Config builds and states which scenes it covers, so the dispatcher never
 // renders a scene with an integrator it does not ask for.
@@ -24,7 +24,7 @@ namespace prism {
 //   then radiance_at from a ray's hit; radiance_row for a row's pixels of one sample each (up
 //   to row_width, `make_path(i)` giving ray i's CameraPath), radiances_at for up to
 //   prelit_width samples of one pixel, which draw from its one stream in their order, where
-//   prelights(). Each gives radiance's bits for every ray: how side by side the work goes is
+//   prelights() (the Renderer calls it only for a streamed sampler, sampler_choice.hpp). Each gives radiance's bits for every ray: how side by side the work goes is
 //   the integrator's choice.
 template <class I, class Real>
 concept Integrator =
@@ -43,8 +43,9 @@ concept Integrator =
         integrator.radiances_at(rays, hits, std::uint32_t(1), 1, path, radiance);
     };
 
-// An integrator policy: `P::template Type<Real, Geometry, LightSet, Textures, Environment>` is
-// the integrator a Renderer builds from its parts; `P::covers(needs)` says whether it renders
+// An integrator policy: `P::template Type<Real, Geometry, LightSet, Textures, Environment,
+// Sampler>` is the integrator a Renderer builds from its parts (Sampler: the pixel sampler its
+// paths draw from, sampling/sampler.hpp); `P::covers(needs)` says whether it renders
 // what the scene asks for.
 template <class P>
 concept IntegratorPolicy = requires(const scene::Needs& needs) {

@@ -45,17 +45,18 @@ Real power_heuristic(Real chosen, Real other) {
 }  // namespace path_tracing
 
 template <Scalar Real, class Geometry, class LightSetT, class Textures = NoTextures<Real>,
-          class Environment = NoEnvironment<Real>>
+          class Environment = NoEnvironment<Real>, class Sampler = IndependentSampler>
 class PathTracerIntegrator {
 public:
-    using RayTracer = WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment>;
+    using RayTracer = WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment, Sampler>;
 
     PathTracerIntegrator(const Geometry& geometry, const LightSetT& lights, const std::vector<Material<Real>>& materials,
                          const Textures& textures, const Environment& environment, const Vec3<Real>& ambient_light,
                          const Vec3<Real>& background, const IntegratorSettings& settings)
         : whitted_(geometry, lights, materials, textures, environment, ambient_light, background, settings),
           geometry_(geometry), lights_(lights), materials_(materials), textures_(textures), environment_(environment),
-          background_(background), settings_(settings), epsilon_(Real(settings.shadow_ray_epsilon)) {
+          background_(background), settings_(settings), epsilon_(Real(settings.shadow_ray_epsilon)),
+          bounce_dimensions_(dimension::lights + 2 * count_lights(lights)) {
         // Which object light each emitting object is, for the density of reaching it by
         // next-event estimation (multiple importance sampling).
         emitters_.assign(geometry.instance_count(), Emitter{});
@@ -69,7 +70,7 @@ public:
     }
 
     struct CameraPath {
-        Random& random;
+        Sampler& sampler;
         Vec2<Real> pixel_uv;
         Real spread = 0;
         scene::RendererParams renderer{};  // the camera's; without path_tracing, the ray tracer renders
@@ -132,20 +133,39 @@ public:
     }
 
 private:
+    // Where a bounce's draws sit in its block of the sampler's dimensions: the same uses at the
+    // same dimensions in every sample, whichever branches earlier bounces took, so each use is
+    // stratified across the pixel's samples by the sampler (a stream ignores the seeks). The
+    // direction's pair serves the BRDF's sample and the rough specular reflection, of which a
+    // bounce takes one; each light of next-event estimation has its pair after the rest.
+    struct dimension {
+        static constexpr int specular_choice = 0, direction = 1, fresnel_choice = 3, transmitted = 4, roulette = 6,
+                             lights = 7;
+    };
+
+    static int count_lights(const LightSetT& lights) {
+        int count = 0;
+        lights.for_each([&](const auto&) { ++count; });
+        return count;
+    }
+
     struct Emitter {
         enum Type : std::uint8_t { none, mesh, sphere } type = none;
         std::uint32_t index = 0;
     };
 
     static typename RayTracer::CameraPath ray_traced(CameraPath& path) {
-        return {path.random, path.pixel_uv, path.spread};
+        return {path.sampler, path.pixel_uv, path.spread};
     }
 
     // The path from a camera ray; `camera_hit` (with `camera_found`): its closest hit, found
     // already (camera_hits), or null to find it here.
     Vec3<Real> trace(Ray<Real> ray, CameraPath& path, const Hit<Real>* camera_hit, bool camera_found) const {
         const scene::RendererParams& params = path.renderer;
-        Random& random = path.random;
+        Sampler& sampler = path.sampler;
+        // Each bounce draws from its own block of the sampler's dimensions (`dimension`), after
+        // those the camera sample took.
+        const int first_dimension = sampler.dimension();
         Vec3<Real> color(0), throughput(1);
         // Whether emission found by this ray counts in full: at the camera, after a specular
         // bounce, or without next-event estimation. Otherwise it was already counted by the
@@ -201,23 +221,27 @@ private:
             // next-event estimation covers the BRDF terms whichever is taken.
             const bool specular = material.type != scene::MaterialType::blinn_phong;
             const Real specular_share = specular ? specular_choice(material, front_face) : Real(0);
+            const int block = first_dimension + depth * bounce_dimensions_;
             if (params.next_event_estimation && specular_share < 1)
-                color += throughput * direct_lighting(point, normal, -d, material, params, random, 1 - specular_share);
-            if (specular_share > 0 && (specular_share >= 1 || random.uniform<Real>() < specular_share)) {
-                direction = specular_direction(d, normal, front_face, material, random, throughput);
+                color += throughput *
+                         direct_lighting(point, normal, -d, material, params, sampler, block, 1 - specular_share);
+            sampler.seek(block + dimension::specular_choice);
+            if (specular_share > 0 && (specular_share >= 1 || sampler.template uniform<Real>() < specular_share)) {
+                direction = specular_direction(d, normal, front_face, material, sampler, block, throughput);
                 throughput /= specular_share;
                 count_emission = true;
             } else {
                 const Vec3<Real> wo = -d;
                 Real density;
                 Vec3<Real> value;
+                sampler.seek(block + dimension::direction);
                 if (params.importance_sampling) {
-                    const BrdfSample<Real> sample = sample_brdf(material, normal, wo, random.uniform2<Real>());
+                    const BrdfSample<Real> sample = sample_brdf(material, normal, wo, sampler.template uniform2<Real>());
                     direction = sample.direction;
                     density = sample.pdf;
                     value = sample.value;
                 } else {
-                    direction = sample_uniform_hemisphere(normal, random.uniform2<Real>());
+                    direction = sample_uniform_hemisphere(normal, sampler.template uniform2<Real>());
                     density = 1 / (2 * pi<Real>);
                     value = evaluate_brdf(material, normal, direction, wo);
                 }
@@ -231,7 +255,8 @@ private:
             if (throughput == Vec3<Real>(0)) break;
             if (params.russian_roulette && depth > 0) {
                 const Real survival = std::min(Real(1), std::max({throughput.x, throughput.y, throughput.z}));
-                if (random.uniform<Real>() >= survival) break;
+                sampler.seek(block + dimension::roulette);
+                if (sampler.template uniform<Real>() >= survival) break;
                 throughput /= survival;
             }
             previous_position = point.position;
@@ -247,11 +272,13 @@ private:
     // Mirrors and conductors reflect; dielectrics reflect or refract, chosen by the Fresnel
     // weight so that the throughput keeps its magnitude (the choice's probability cancels it).
     Vec3<Real> specular_direction(const Vec3<Real>& d, const Vec3<Real>& normal, bool front_face,
-                                  const Material<Real>& material, Random& random, Vec3<Real>& throughput) const {
+                                  const Material<Real>& material, Sampler& sampler, int block,
+                                  Vec3<Real>& throughput) const {
         using scene::MaterialType;
         const Real cos_incident = -glm::dot(d, normal);
         Vec3<Real> reflected = d + 2 * cos_incident * normal;
-        if (material.roughness > 0) reflected = perturb(reflected, material.roughness, random.uniform2<Real>());
+        sampler.seek(block + dimension::direction);
+        if (material.roughness > 0) reflected = perturb(reflected, material.roughness, sampler.template uniform2<Real>());
         if (material.type == MaterialType::mirror) {
             throughput *= material.mirror;
             return reflected;
@@ -268,9 +295,11 @@ private:
         if (sin2_transmitted >= 1) return reflected;
         const Real cos_transmitted = std::sqrt(1 - sin2_transmitted);
         const Real fresnel = fresnel_dielectric(cos_incident, cos_transmitted, n1, n2);
-        if (random.uniform<Real>() < fresnel) return reflected;
+        sampler.seek(block + dimension::fresnel_choice);
+        if (sampler.template uniform<Real>() < fresnel) return reflected;
         Vec3<Real> transmitted = unit_vector(ratio * d + (ratio * cos_incident - cos_transmitted) * normal);
-        if (material.roughness > 0) transmitted = perturb(transmitted, material.roughness, random.uniform2<Real>());
+        sampler.seek(block + dimension::transmitted);
+        if (material.roughness > 0) transmitted = perturb(transmitted, material.roughness, sampler.template uniform2<Real>());
         if (material.transparency != Vec3<Real>(0)) throughput *= material.transparency;
         return transmitted;
     }
@@ -297,10 +326,13 @@ private:
     // scales that strategy's density in the MIS weight.
     Vec3<Real> direct_lighting(const SurfacePoint<Real>& point, const Vec3<Real>& normal, const Vec3<Real>& wo,
                                const Material<Real>& material, const scene::RendererParams& params,
-                               Random& random, Real brdf_share = 1) const {
+                               Sampler& sampler, int block, Real brdf_share) const {
         Vec3<Real> color(0);
+        int light_dimension = block + dimension::lights;
         lights_.for_each([&](const auto& light) {
-            const LightSample<Real> sample = light.sample({point.position, normal}, random.uniform2<Real>());
+            sampler.seek(light_dimension);
+            light_dimension += 2;
+            const LightSample<Real> sample = light.sample({point.position, normal}, sampler.template uniform2<Real>());
             const Real cos_light = glm::dot(normal, sample.direction);
             if (cos_light <= 0 || sample.radiance == Vec3<Real>(0)) return;
             Ray<Real> shadow = leaving(point, normal, sample.direction, point.time);
@@ -363,13 +395,14 @@ private:
     Vec3<Real> background_;
     IntegratorSettings settings_;
     Real epsilon_;
+    int bounce_dimensions_;          // the sampler's dimensions a bounce takes (`dimension`)
     std::vector<Emitter> emitters_;  // per object of the geometry
 };
 
 // The Config policy that path traces the cameras asking for it (and ray traces the others).
 struct PathTracer {
-    template <Scalar Real, class Geometry, class LightSetT, class Textures, class Environment>
-    using Type = PathTracerIntegrator<Real, Geometry, LightSetT, Textures, Environment>;
+    template <Scalar Real, class Geometry, class LightSetT, class Textures, class Environment, class Sampler>
+    using Type = PathTracerIntegrator<Real, Geometry, LightSetT, Textures, Environment, Sampler>;
 
     static constexpr bool covers(const scene::Needs&) { return true; }
 };

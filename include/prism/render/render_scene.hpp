@@ -72,6 +72,7 @@ struct RenderOptions {
     BackfaceCulling backface_culling = BackfaceCulling::triangles;  // what camera rays skip from behind
     std::optional<RayOffset> ray_offset;  // empty: chosen from the scene (choose_ray_offset)
     std::uint64_t seed = 0;               // the pixels' random streams (multisampling, lights)
+    std::optional<SamplerKind> sampler;   // empty: default_sampler (sampling/sampler_choice.hpp)
     AcceleratorChoice accelerator = AcceleratorChoice::prism;
 };
 
@@ -213,7 +214,7 @@ std::vector<CameraImage> render_with(const scene::Scene& scene, const RenderOpti
                                      const std::function<void(std::size_t camera, int pixels)>& on_tile) {
     using Clock = std::chrono::steady_clock;
     const auto build_start = Clock::now();
-    const Renderer<C> renderer(scene, RendererSettings{options.backface_culling, *options.ray_offset, options.seed});
+    const Renderer<C> renderer(scene, RendererSettings{options.backface_culling, *options.ray_offset, options.seed, options.sampler});
     const double build_seconds = std::chrono::duration<double>(Clock::now() - build_start).count();
     log << "built " << renderer.geometry().instance_count() << " instances, " << renderer.geometry().triangle_count()
         << " triangles in " << build_seconds << " s\n";

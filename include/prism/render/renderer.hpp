@@ -1,8 +1,9 @@
 // The renderer a Config composes: geometry built in the Config's precision with its
 // acceleration policy, its light set, textures and motion blur if the Config asks for them, the
 // course's integrator, and tiles of pixels rendered in parallel with TBB into an HDR image.
-// Every pixel draws its samples from its own random stream (sampling/random.hpp), so an image
-// is bit-identical whatever the number of threads.
+// Every pixel draws its samples from its own sampler (the Config's sampler policy,
+// sampling/sampler_choice.hpp), keyed by the pixel and the seed, so an image is bit-identical
+// whatever the number of threads.
 #pragma once
 
 #include <prism/camera/pixel_sampler.hpp>
@@ -22,9 +23,11 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace prism {
@@ -33,6 +36,7 @@ struct RendererSettings {
     BackfaceCulling backface_culling = BackfaceCulling::triangles;  // what camera rays skip from behind
     RayOffset ray_offset = RayOffset::scene_epsilon;
     std::uint64_t seed = 0;       // selects the pixels' random streams
+    std::optional<SamplerKind> sampler;  // empty: the Config's sampler policy's own (default_sampler)
 };
 
 template <class C>
@@ -45,14 +49,17 @@ public:
     using TexturesT = std::conditional_t<features.textures, TextureSet<Real>, NoTextures<Real>>;
     static constexpr bool environment_lights = C::LightTypes::template contains<EnvironmentLight>;
     using EnvironmentT = std::conditional_t<environment_lights, EnvironmentBackground<Real>, NoEnvironment<Real>>;
-    using Integrator = typename C::IntegratorPolicy::template Type<Real, Geometry, LightSetT, TexturesT, EnvironmentT>;
+    using Pattern = typename C::SamplerPolicy;
+    using PixelSamplerT = decltype(std::declval<const Pattern&>().for_pixel(0, 0));
+    using Integrator =
+        typename C::IntegratorPolicy::template Type<Real, Geometry, LightSetT, TexturesT, EnvironmentT, PixelSamplerT>;
     static_assert(prism::Integrator<Integrator, Real>);
 
     static constexpr int tile_size = 16;
 
     explicit Renderer(const scene::Scene& scene, const RendererSettings& settings = {})
         : geometry_(check_features(scene)), lights_(scene), materials_(convert_materials(scene)), textures_(scene),
-          environment_(make_environment(lights_)), settings_(settings),
+          environment_(make_environment(lights_)), settings_(check_sampler(settings)),
           integrator_(geometry_, lights_, materials_, textures_, environment_, Vec3<Real>(scene.ambient_light),
                       Vec3<Real>(scene.background_color),
                       IntegratorSettings{scene.max_recursion_depth, scene.shadow_ray_epsilon, settings.ray_offset,
@@ -75,17 +82,19 @@ public:
         const ThinLensCamera<Real> lens(camera, width, height);
         const int count = std::max(1, camera.num_samples);
         const Real spread = lens.pixel_spread();
+        const Pattern pattern = make_pattern<Pattern>({count, width, height, settings_.seed, settings_.sampler});
         Image image(width, height, Image::Unfilled{});  // every pixel is written below
         tbb::parallel_for(tbb::blocked_range2d<int>(0, height, tile_size, 0, width, tile_size),
                           [&](const tbb::blocked_range2d<int>& tile) {
                               PixelScratch scratch;
                               for (int y = tile.rows().begin(); y < tile.rows().end(); ++y) {
                                   if (count == 1) {
-                                      one_sample_row(lens, camera, spread, y, tile.cols().begin(), tile.cols().end(), image);
+                                      one_sample_row(lens, camera, pattern, spread, y, tile.cols().begin(),
+                                                     tile.cols().end(), image);
                                       continue;
                                   }
                                   for (int x = tile.cols().begin(); x < tile.cols().end(); ++x)
-                                      image(x, y) = pixel(lens, camera, spread, count, x, y, scratch);
+                                      image(x, y) = pixel(lens, camera, pattern, spread, count, x, y, scratch);
                               }
                               on_tile(int(tile.rows().size() * tile.cols().size()));
                           });
@@ -93,22 +102,28 @@ public:
     }
 
     // Radiance along one ray (unit direction) at shutter instant ray.time, for tests and tools;
-    // lights and roughness are sampled from the stream of pixel (0, 0).
+    // lights and roughness are sampled from the first sample of pixel (0, 0), from its first
+    // dimension.
     Vec3<Real> radiance(const Ray<Real>& ray) const {
-        Random random = Random::for_pixel(0, 0, settings_.seed);
-        typename Integrator::CameraPath path{random, Vec2<Real>(Real(0.5))};
+        PixelSamplerT sampler = make_pattern<Pattern>({1, 1, 1, settings_.seed, settings_.sampler}).for_pixel(0, 0);
+        sampler.start_sample(0);
+        typename Integrator::CameraPath path{sampler, Vec2<Real>(Real(0.5))};
         return integrator_.radiance(ray, path);
     }
 
 private:
-    // The path a camera ray of pixel (x, y) carries, drawing from `random`. `spread` is
+    // Whether the Pattern can be a stream (IndependentPattern, ChosenPattern): only those
+    // compile the streamed routes, which draw the camera samples from a Random first.
+    static constexpr bool can_stream = std::is_constructible_v<PixelSamplerT, IndependentSampler>;
+
+    // The path a camera ray of pixel (x, y) carries, drawing from `sampler`. `spread` is
     // lens.pixel_spread(), computed once a render: two square roots and a division, which each
     // pixel waited for before its trace (a fifth of the per-row samples on hw1 simple_reflectance
     // once the rows were batched).
     typename Integrator::CameraPath camera_path(const ThinLensCamera<Real>& lens, const scene::Camera& camera,
-                                                Real spread, Random& random, int x, int y) const {
+                                                Real spread, PixelSamplerT& sampler, int x, int y) const {
         typename Integrator::CameraPath path{
-            random, Vec2<Real>((Real(x) + Real(0.5)) / Real(lens.width()), (Real(y) + Real(0.5)) / Real(lens.height())),
+            sampler, Vec2<Real>((Real(x) + Real(0.5)) / Real(lens.width()), (Real(y) + Real(0.5)) / Real(lens.height())),
             spread};
         // Integrators that render cameras differently (the path tracer's RendererParams) learn
         // the camera's choice here.
@@ -125,29 +140,45 @@ private:
     // where one pixel at a time waited for them before its trace (the per-pixel lambda was
     // 13-14% of hw1 simple_reflectance's samples, an eighth of them on the instruction after the
     // ray's division).
-    void one_sample_row(const ThinLensCamera<Real>& lens, const scene::Camera& camera, Real spread, int y, int begin,
-                        int end, Image& image) const {
+    // With a sampler that is not a stream, each pixel's sampler gives its sample 0's lens point
+    // and time from the camera's dimensions (camera_sample), at the pixel's centre.
+    void one_sample_row(const ThinLensCamera<Real>& lens, const scene::Camera& camera, const Pattern& pattern,
+                        Real spread, int y, int begin, int end, Image& image) const {
         constexpr int batch = tile_size;
-        std::array<Random, batch> streams;
+        Unconstructed<PixelSamplerT, batch> samplers;
         std::array<Ray<Real>, batch> rays;
+        const bool stream = streamed(pattern);
         for (int start = begin; start < end; start += batch) {
             const int n = std::min(batch, end - start);
-            if (!lens.has_aperture()) {
-                // A pinhole, which never reads the lens point: the row's streams stepped past
-                // the lens's two draws, and its rays, lane by lane
-                // (Random::for_row, ThinLensCamera::centre_rays), the time drawn between them,
-                // as centre_sample draws it. Lanes past the row's end are made and not used.
-                std::array<Real, batch> times;
-                Random::for_row<Real>(start, y, settings_.seed, 2, streams, times);
-                lens.centre_rays(start, y, times, rays);
-            } else {
+            if (!stream) {
                 for (int i = 0; i < n; ++i) {
                     const int x = start + i;
-                    streams[std::size_t(i)] = Random::for_pixel(x, y, settings_.seed);
-                    const CameraSample<Real> sample = centre_sample<Real>(streams[std::size_t(i)]);
+                    PixelSamplerT& sampler = samplers.make(std::size_t(i), pattern.for_pixel(x, y));
+                    sampler.start_sample(0);
+                    const CameraSample<Real> sample = camera_sample<Real>(sampler, true);
                     rays[std::size_t(i)] = stored_whole(
                         lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time));
                 }
+            } else if constexpr (can_stream) {
+                std::array<Random, batch> streams;
+                if (!lens.has_aperture()) {
+                    // A pinhole, which never reads the lens point: the row's streams stepped past
+                    // the lens's two draws, and its rays, lane by lane
+                    // (Random::for_row, ThinLensCamera::centre_rays), the time drawn between them,
+                    // as centre_sample draws it. Lanes past the row's end are made and not used.
+                    std::array<Real, batch> times;
+                    Random::for_row<Real>(start, y, settings_.seed, 2, streams, times);
+                    lens.centre_rays(start, y, times, rays);
+                } else {
+                    for (int i = 0; i < n; ++i) {
+                        const int x = start + i;
+                        streams[std::size_t(i)] = Random::for_pixel(x, y, settings_.seed);
+                        const CameraSample<Real> sample = centre_sample<Real>(streams[std::size_t(i)]);
+                        rays[std::size_t(i)] = stored_whole(
+                            lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time));
+                    }
+                }
+                for (int i = 0; i < n; ++i) samplers.make(std::size_t(i), IndependentSampler(streams[std::size_t(i)]));
             }
             // Where the integrator batches camera rays, the row's closest hits first, then its
             // shading (radiance_row: the row's shadow rays side by side where the integrator can).
@@ -156,7 +187,7 @@ private:
                 std::array<Hit<Real>, batch> hits;
                 const std::uint32_t found = integrator_.camera_hits(rays.data(), hits.data(), n);
                 const auto make_path = [&](int i) {
-                    return camera_path(lens, camera, spread, streams[std::size_t(i)], start + i, y);
+                    return camera_path(lens, camera, spread, samplers[std::size_t(i)], start + i, y);
                 };
                 std::array<Vec3<Real>, batch> radiance;
                 integrator_.radiance_row(rays.data(), hits.data(), found, n, make_path, radiance.data());
@@ -165,7 +196,7 @@ private:
             }
             for (int i = 0; i < n; ++i) {
                 const int x = start + i;
-                typename Integrator::CameraPath path = camera_path(lens, camera, spread, streams[std::size_t(i)], x, y);
+                typename Integrator::CameraPath path = camera_path(lens, camera, spread, samplers[std::size_t(i)], x, y);
                 image(x, y) = one_sample_pixel(integrator_.radiance(rays[std::size_t(i)], path));
             }
         }
@@ -187,12 +218,36 @@ private:
     // A pixel of several samples: every sample's ray and filter weight first, then the traces.
     // As in one_sample_row, the rays and weights depend on no trace (and draw nothing), so
     // their divisions, square roots and exponentials overlap, and the sums are the same.
-    glm::vec3 pixel(const ThinLensCamera<Real>& lens, const scene::Camera& camera, Real spread, int count, int x,
-                    int y, PixelScratch& scratch) const {
+    // A stream (streamed(pattern)) draws every camera sample first, stratified across the pixel
+    // (camera_samples), and the samples' paths then go on drawing from it in their order. Any
+    // other sampler gives sample i its camera sample and its path's numbers from its own
+    // dimensions (start_sample(i)), so each sample's path starts past the camera's dimensions.
+    glm::vec3 pixel(const ThinLensCamera<Real>& lens, const scene::Camera& camera, const Pattern& pattern, Real spread,
+                    int count, int x, int y, PixelScratch& scratch) const {
         const scene::PixelFilter filter = camera.filter;
-        Random random = Random::for_pixel(x, y, settings_.seed);
-        typename Integrator::CameraPath path = camera_path(lens, camera, spread, random, x, y);
-        camera_samples(count, random, scratch.samples, scratch.strata);
+        const bool stream = streamed(pattern);
+        PixelSamplerT sampler = [&] {
+            if constexpr (can_stream) {
+                if (stream) {
+                    Random random = Random::for_pixel(x, y, settings_.seed);
+                    camera_samples(count, random, scratch.samples, scratch.strata);
+                    return PixelSamplerT(IndependentSampler(random));
+                }
+            }
+            PixelSamplerT pixel_sampler = pattern.for_pixel(x, y);
+            scratch.samples.resize(std::size_t(count));
+            for (int i = 0; i < count; ++i) {
+                pixel_sampler.start_sample(i);
+                scratch.samples[std::size_t(i)] = camera_sample<Real>(pixel_sampler, false);
+            }
+            return pixel_sampler;
+        }();
+        const auto start_sample = [&](std::size_t i) {
+            if (stream) return;
+            sampler.start_sample(int(i));
+            sampler.seek(camera_dimensions);
+        };
+        typename Integrator::CameraPath path = camera_path(lens, camera, spread, sampler, x, y);
         const std::size_t n = scratch.samples.size();
         scratch.rays.resize(n);
         scratch.weights.resize(n);
@@ -217,8 +272,9 @@ private:
                 Ray<Real>* const rays = scratch.rays.data() + first;
                 const std::uint32_t found = integrator_.camera_hits(rays, hits.data(), count);
                 // Where the integrator samples the lights that draw nothing for several samples
-                // first (prelights), their shadow rays go side by side.
-                if (integrator_.prelights()) {
+                // first (prelights), their shadow rays go side by side: samples that draw from
+                // one stream in their order.
+                if (stream && integrator_.prelights()) {
                     constexpr int width = Integrator::prelit_width;
                     std::array<Vec3<Real>, width> radiance;
                     for (int part = 0; part < count; part += width) {
@@ -234,6 +290,7 @@ private:
                 }
                 for (int i = 0; i < count; ++i) {
                     const Real weight = scratch.weights[first + std::size_t(i)];
+                    start_sample(first + std::size_t(i));
                     sum += weight * integrator_.radiance_at(rays[i], hits[std::size_t(i)], (found >> i) & 1, path);
                     weights += weight;
                 }
@@ -241,6 +298,7 @@ private:
             return glm::vec3(sum / weights);
         }
         for (std::size_t i = 0; i < n; ++i) {
+            start_sample(i);
             sum += scratch.weights[i] * integrator_.radiance(scratch.rays[i], path);
             weights += scratch.weights[i];
         }
@@ -270,6 +328,13 @@ private:
             throw std::invalid_argument(name + std::to_string(camera.num_samples) +
                                         " samples per pixel are more than the limit of " +
                                         std::to_string(io::max_samples_per_pixel));
+    }
+
+    // A sampler kind that the Config's sampler policy does not hold is refused when the renderer
+    // is made (make_pattern), not at its first render.
+    static const RendererSettings& check_sampler(const RendererSettings& settings) {
+        (void)make_pattern<Pattern>({1, 1, 1, settings.seed, settings.sampler});
+        return settings;
     }
 
     // A renderer compiled without a light kind, a feature or an integrator the scene needs

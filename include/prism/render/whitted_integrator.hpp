@@ -20,7 +20,7 @@
 #include <prism/memory/unconstructed.hpp>
 #include <prism/render/integrator.hpp>
 #include <prism/render/stored_whole.hpp>
-#include <prism/sampling/random.hpp>
+#include <prism/sampling/sampler.hpp>
 #include <prism/texture/mipmap.hpp>
 
 #include <algorithm>
@@ -134,7 +134,7 @@ Vec3<Real> perturb(const Vec3<Real>& direction, Real roughness, const Vec2<Real>
 }
 
 template <Scalar Real, class Geometry, class LightSetT, class Textures = NoTextures<Real>,
-          class Environment = NoEnvironment<Real>>
+          class Environment = NoEnvironment<Real>, class Sampler = IndependentSampler>
 class WhittedIntegrator {
     // The error-bounded origins of the rays leaving one surface point, one per side they leave
     // by (SceneSurfaces::spawn_side), each computed for the first ray that needs it: the shadow
@@ -156,7 +156,7 @@ public:
 
     // What a camera ray carries down its recursion besides the ray itself.
     struct CameraPath {
-        Random& random;      // the pixel's stream
+        Sampler& sampler;    // the pixel's sampler (sampling/sampler.hpp)
         Vec2<Real> pixel_uv; // the pixel's position in [0, 1]^2 from the top left (background texture)
         Real spread = 0;     // the pixel's angular size: the ray cone's spread (trilinear textures)
     };
@@ -277,7 +277,7 @@ private:
         travelled += hit.t;
         const RayCone<Real> cone{travelled * path.spread, std::abs(glm::dot(ray.direction, point.shading_normal))};
         if (const std::optional<Vec3<Real>> unshaded = textures_.apply(point, material, cone)) return *unshaded;
-        Random& random = path.random;
+        Sampler& sampler = path.sampler;
         const Vec3<Real>& d = ray.direction;
         const bool front_face = glm::dot(point.geometric_normal, d) < 0;
         // Shading uses the normal on the side the ray arrives from.
@@ -292,7 +292,7 @@ private:
         if (!inside_medium) {
             // Object lights (LightMesh, LightSphere) are seen by every ray that finds them.
             color = geometry_.emitted(hit.object) + material.ambient * ambient_light_;
-            color += direct_lighting(point, normal, -d, material, random, origins);
+            color += direct_lighting(point, normal, -d, material, sampler, origins);
         }
 
         return reflect_and_absorb(ray, hit, point, material, normal, front_face, inside_medium, color, depth, path,
@@ -348,7 +348,7 @@ private:
         const Vec3<Real>& d = ray.direction;
         cos_incident = -glm::dot(d, normal);
         Vec3<Real> reflected = d + 2 * cos_incident * normal;
-        if (material.roughness > 0) reflected = perturb(reflected, material.roughness, path.random.template uniform2<Real>());
+        if (material.roughness > 0) reflected = perturb(reflected, material.roughness, path.sampler.template uniform2<Real>());
         return stored_whole(leaving(point, normal, reflected, ray.time, origins));
     }
 
@@ -397,14 +397,14 @@ private:
     // `origins`: the point's shadow rays take their origins from it and leave theirs in it for
     // the reflected and refracted rays.
     Vec3<Real> direct_lighting(const SurfacePoint<Real>& point, const Vec3<Real>& normal, const Vec3<Real>& to_viewer,
-                               const Material<Real>& material, Random& random, SpawnOrigins& origins) const {
+                               const Material<Real>& material, Sampler& sampler, SpawnOrigins& origins) const {
         if constexpr (std::is_same_v<LightSetT, LightSet<Real, PointLight>>) {
             const std::vector<PointLight<Real>>& lights = *lights_.template of_type<PointLight>();
             if (lights.size() > 1)
-                return point_lighting_batched(point, normal, to_viewer, material, random, origins, lights);
+                return point_lighting_batched(point, normal, to_viewer, material, sampler, origins, lights);
         }
         Vec3<Real> color(0);
-        lights_.for_each([&](const auto& light) { light_term(light, point, normal, to_viewer, material, random, origins, color); });
+        lights_.for_each([&](const auto& light) { light_term(light, point, normal, to_viewer, material, sampler, origins, color); });
         return color;
     }
 
@@ -412,7 +412,7 @@ private:
     // blocked.
     template <class L>
     PRISM_FORCE_INLINE void light_term(const L& light, const SurfacePoint<Real>& point, const Vec3<Real>& normal,
-                                           const Vec3<Real>& to_viewer, const Material<Real>& material, Random& random,
+                                           const Vec3<Real>& to_viewer, const Material<Real>& material, Sampler& sampler,
                                            SpawnOrigins& origins, Vec3<Real>& color) const {
         const Vec3<Real>& position = point.position;
         // A light that takes no sample (point, directional, spot: sample(at) alone) gets none
@@ -421,10 +421,10 @@ private:
         const ShadingFrame<Real> at{position, normal};
         const LightSample<Real> sample = [&] {
             if constexpr (draws_nothing<L>) {
-                random.template skip<Real>(2);
+                sampler.template skip<Real>(2);
                 return light.sample(at);
             } else {
-                return light.sample(at, random.uniform2<Real>());
+                return light.sample(at, sampler.template uniform2<Real>());
             }
         }();
         const Real cos_light = glm::dot(normal, sample.direction);
@@ -457,7 +457,7 @@ private:
     template <class PointLights>
     [[gnu::noinline]] Vec3<Real> point_lighting_batched(const SurfacePoint<Real>& point, const Vec3<Real>& normal,
                                                         const Vec3<Real>& to_viewer, const Material<Real>& material,
-                                                        Random& random, SpawnOrigins& origins, const PointLights& lights) const {
+                                                        Sampler& sampler, SpawnOrigins& origins, const PointLights& lights) const {
         constexpr std::size_t batch = 8;
         Vec3<Real> color(0);
         const Vec3<Real>& position = point.position;
@@ -473,7 +473,7 @@ private:
             Unconstructed<Ray<Real>, batch> shadows;
             std::uint32_t lit = 0;
             for (std::size_t i = 0; i < count; ++i) {
-                random.template skip<Real>(2);
+                sampler.template skip<Real>(2);
                 const LightSample<Real> sample = lights[first + i].sample(at);
                 directions[i] = sample.direction;
                 radiances[i] = sample.radiance;
@@ -545,8 +545,8 @@ private:
         const Real cos_transmitted = std::sqrt(1 - sin2_transmitted);
         const Real fresnel = fresnel_dielectric(cos_incident, cos_transmitted, n1, n2);
         Vec3<Real> transmitted = unit_vector(ratio * d + (ratio * cos_incident - cos_transmitted) * normal);
-        Random& random = path.random;
-        if (material.roughness > 0) transmitted = perturb(transmitted, material.roughness, random.uniform2<Real>());
+        Sampler& sampler = path.sampler;
+        if (material.roughness > 0) transmitted = perturb(transmitted, material.roughness, sampler.template uniform2<Real>());
         const Ray<Real> refraction = stored_whole(leaving(point, normal, transmitted, reflection.time, origins));
         Vec3<Real> through = (1 - fresnel) * trace(refraction, depth + 1, path, travelled);
         // Pre-2020 scenes describe glass by a Transparency colour that filters what passes.
@@ -568,8 +568,8 @@ private:
 
 // The Config policy that renders with the course's recursive ray tracer.
 struct Whitted {
-    template <Scalar Real, class Geometry, class LightSetT, class Textures, class Environment>
-    using Type = WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment>;
+    template <Scalar Real, class Geometry, class LightSetT, class Textures, class Environment, class Sampler>
+    using Type = WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment, Sampler>;
 
     // Not scenes with a path-traced camera: those need the PathTracer policy.
     static constexpr bool covers(const scene::Needs& needs) { return !needs.path_tracing; }

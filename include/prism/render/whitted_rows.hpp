@@ -10,8 +10,8 @@
 
 namespace prism {
 
-template <Scalar Real, class Geometry, class LightSetT, class Textures, class Environment>
-void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment>::radiances_at(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count,
+template <Scalar Real, class Geometry, class LightSetT, class Textures, class Environment, class Sampler>
+void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment, Sampler>::radiances_at(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count,
                                                                                   CameraPath& path, Vec3<Real>* radiance) const {
     // shade's state at a camera hit up to its direct lighting (the point made in place).
     struct PrelitPoint {
@@ -126,7 +126,7 @@ void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment>::radian
                 if constexpr (draws_nothing<std::decay_t<decltype(light)>>) {
                     if (light_index < prelit_lights) {
                         const std::size_t j = light_index++;
-                        path.random.template skip<Real>(2);
+                        path.sampler.template skip<Real>(2);
                         if (!((at.visible >> j) & 1)) return;
                         LightSample<Real> sample;
                         sample.direction = directions[j][std::size_t(i)];
@@ -135,7 +135,7 @@ void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment>::radian
                         return;
                     }
                 }
-                light_term(light, at.point, at.normal, to_viewer, material, path.random, at.origins, direct);
+                light_term(light, at.point, at.normal, to_viewer, material, path.sampler, at.origins, direct);
             });
             color += direct;
         }
@@ -147,10 +147,10 @@ void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment>::radian
 // radiance_row's rows at `depth`: rays[i] has travelled `travelled[i]` before its origin
 // (camera rays, `Primary`: none, and depth 0) and draws from paths[i]. shade's work, pass by
 // pass across the row.
-template <Scalar Real, class Geometry, class LightSetT, class Textures, class Environment>
+template <Scalar Real, class Geometry, class LightSetT, class Textures, class Environment, class Sampler>
 template <bool Primary>
     requires(!textured<Textures, Real> && std::is_same_v<LightSetT, LightSet<Real, PointLight>>)
-void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment>::shade_row(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count,
+void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment, Sampler>::shade_row(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count,
                                                                                CameraPath* paths, const Real* travelled, int depth,
                                                                                Vec3<Real>* radiance) const {
     if constexpr (Primary) depth = 0;
@@ -191,7 +191,7 @@ void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment>::shade_
         // direct_lighting's samples and shadow rays are made below, light by light across
         // the row (point_light_lanes); the stream steps past their draws now, in the same order.
         const Vec3<Real>& position = at.point.position;
-        for (std::size_t k = 0; k < lights.size(); ++k) path.random.template skip<Real>(2);
+        for (std::size_t k = 0; k < lights.size(); ++k) path.sampler.template skip<Real>(2);
         for (int axis = 0; axis < 3; ++axis) {
             row.position[axis][i] = position[axis];
             row.normal[axis][i] = at.normal[axis];

@@ -27,13 +27,19 @@ namespace prism {
 // What an integrator and the renderer call on a pixel's sampler. uniform() takes one dimension,
 // uniform2() two; skip<Real>(n) passes n dimensions without drawing them, so that every later
 // use keeps its dimension whether or not the skipped ones were needed (a point light needs no
-// sample of its surface).
+// sample of its surface). dimension() is the next dimension to be drawn and seek(d) makes it d:
+// a path tracer gives each bounce a fixed block of dimensions, so that a branch that draws less
+// (a specular bounce, no Fresnel choice) does not shift every later bounce's numbers. A stream
+// (IndependentSampler) has no dimensions: its draws are simply the next numbers, skip steps it
+// as it always has, and seek leaves it where it is, so seeking changes no independent image.
 template <class S, class Real>
-concept PixelSampler = Scalar<Real> && requires(S& sampler, int index, int count) {
+concept PixelSampler = Scalar<Real> && requires(S& sampler, const S& const_sampler, int index, int count) {
     sampler.start_sample(index);  // sample `index` of the pixel, from its first dimension
     { sampler.template uniform<Real>() } -> std::same_as<Real>;
     { sampler.template uniform2<Real>() } -> std::same_as<Vec2<Real>>;
     sampler.template skip<Real>(count);
+    { const_sampler.dimension() } -> std::same_as<int>;
+    sampler.seek(count);
 };
 
 // A render's pattern makes each pixel's sampler; samples_per_pixel is the pixel's sample count.
@@ -49,6 +55,8 @@ class IndependentSampler : public Random {
 public:
     explicit constexpr IndependentSampler(const Random& stream) : Random(stream) {}
     constexpr void start_sample(int) {}
+    constexpr int dimension() const { return 0; }
+    constexpr void seek(int) {}
 };
 
 class IndependentPattern {

@@ -120,6 +120,8 @@ public:
     constexpr void skip(int count) {
         dimension_ += count;
     }
+    constexpr int dimension() const { return dimension_; }
+    constexpr void seek(int dimension) { dimension_ = dimension; }
 
 private:
     // The Sobol' index the current dimension takes for the current sample: the sample's index

@@ -90,6 +90,8 @@ public:
     constexpr void skip(int count) {
         dimension_ += count;
     }
+    constexpr int dimension() const { return dimension_; }
+    constexpr void seek(int dimension) { dimension_ = dimension; }
 
 private:
     constexpr std::uint64_t dimension_key() const { return sampling::hash_key(pixel_key_, std::uint64_t(dimension_), seed_); }

@@ -1,0 +1,160 @@
+// The sampler a render uses, as a Config policy (render/config.hpp): a pattern type. Three fix
+// one sampler at compile time (IndependentPattern, StratifiedPattern, ZSobolPattern); a fourth,
+// ChosenPattern, takes the choice at run time (RendererSettings::sampler, `--sampler`), which is
+// what the shipped renderers use: one integrator per Config instead of three, and a switch per
+// draw that the branch predictor always gets right (the sampler of a render never changes).
+#pragma once
+
+#include <prism/sampling/sampler.hpp>
+#include <prism/sampling/sobol.hpp>
+#include <prism/sampling/stratified.hpp>
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <type_traits>
+
+namespace prism {
+
+enum class SamplerKind : std::uint8_t { independent, stratified, sobol };
+
+// The kind a render uses where nobody chose one (RendererSettings::sampler left empty with the
+// ChosenPattern policy): chosen by measurement, bench/RESULTS.md "Samplers".
+inline constexpr SamplerKind default_sampler = SamplerKind::independent;
+
+constexpr std::string_view sampler_name(SamplerKind kind) {
+    constexpr std::array<std::string_view, 3> names{"independent", "stratified", "sobol"};
+    return names[std::size_t(kind)];
+}
+
+inline std::optional<SamplerKind> parse_sampler(std::string_view name) {
+    for (SamplerKind kind : {SamplerKind::independent, SamplerKind::stratified, SamplerKind::sobol})
+        if (name == sampler_name(kind)) return kind;
+    return std::nullopt;
+}
+
+// One of the three pixel samplers, chosen at run time.
+class ChosenSampler {
+    // f applied to the sampler of the chosen kind (defined before its callers, whose return
+    // types it deduces).
+    template <class Self, class F>
+    static constexpr decltype(auto) visit(Self& self, F f) {
+        switch (self.kind_) {
+            case SamplerKind::stratified: return f(self.stratified_);
+            case SamplerKind::sobol: return f(self.sobol_);
+            default: return f(self.independent_);
+        }
+    }
+
+public:
+    explicit constexpr ChosenSampler(const IndependentSampler& sampler)
+        : kind_(SamplerKind::independent), independent_(sampler) {}
+    explicit constexpr ChosenSampler(const StratifiedSampler& sampler)
+        : kind_(SamplerKind::stratified), stratified_(sampler) {}
+    explicit constexpr ChosenSampler(const ZSobolSampler& sampler) : kind_(SamplerKind::sobol), sobol_(sampler) {}
+
+    constexpr void start_sample(int index) {
+        visit(*this, [&](auto& sampler) { sampler.start_sample(index); });
+    }
+    template <Scalar Real>
+    constexpr Real uniform() {
+        return visit(*this, [](auto& sampler) { return sampler.template uniform<Real>(); });
+    }
+    template <Scalar Real>
+    constexpr Vec2<Real> uniform2() {
+        return visit(*this, [](auto& sampler) { return sampler.template uniform2<Real>(); });
+    }
+    template <Scalar Real>
+    constexpr void skip(int count) {
+        visit(*this, [&](auto& sampler) { sampler.template skip<Real>(count); });
+    }
+    constexpr int dimension() const {
+        return visit(*this, [](const auto& sampler) { return sampler.dimension(); });
+    }
+    constexpr void seek(int dimension) {
+        visit(*this, [&](auto& sampler) { sampler.seek(dimension); });
+    }
+
+private:
+    SamplerKind kind_;
+    union {
+        IndependentSampler independent_;
+        StratifiedSampler stratified_;
+        ZSobolSampler sobol_;
+    };
+};
+
+// The render's numbers, for every pattern: its sample count, image size and seed, and the kind
+// asked for (empty: the pattern's own, or default_sampler where the pattern leaves it open).
+struct SamplingLayout {
+    int samples_per_pixel = 1;
+    int width = 1, height = 1;
+    std::uint64_t seed = 0;
+    std::optional<SamplerKind> kind;
+};
+
+class ChosenPattern {
+public:
+    explicit ChosenPattern(const SamplingLayout& layout)
+        : kind_(layout.kind.value_or(default_sampler)), independent_(layout.samples_per_pixel, layout.seed),
+          stratified_(layout.samples_per_pixel, layout.seed),
+          sobol_(layout.samples_per_pixel, layout.width, layout.height, layout.seed) {}
+
+    ChosenSampler for_pixel(int x, int y) const {
+        switch (kind_) {
+            case SamplerKind::stratified: return ChosenSampler(stratified_.for_pixel(x, y));
+            case SamplerKind::sobol: return ChosenSampler(sobol_.for_pixel(x, y));
+            default: return ChosenSampler(independent_.for_pixel(x, y));
+        }
+    }
+    int samples_per_pixel() const { return independent_.samples_per_pixel(); }
+    // Whether the pixel's samples draw from one stream in order (see streamed()).
+    bool streamed() const { return kind_ == SamplerKind::independent; }
+
+private:
+    SamplerKind kind_;
+    IndependentPattern independent_;
+    StratifiedPattern stratified_;
+    ZSobolPattern sobol_;
+};
+
+// A pattern of the given type for a render's layout. A pattern that fixes its kind refuses
+// another one, so that a renderer never renders with a sampler other than the one asked for.
+template <class Pattern>
+Pattern make_pattern(const SamplingLayout& layout) {
+    const auto fixed = [&](SamplerKind kind) {
+        if (layout.kind && *layout.kind != kind)
+            throw std::invalid_argument("the sampler " + std::string(sampler_name(*layout.kind)) +
+                                        " was asked for, and this renderer was compiled with " +
+                                        std::string(sampler_name(kind)) + " only");
+    };
+    if constexpr (std::is_same_v<Pattern, ChosenPattern>) {
+        return ChosenPattern(layout);
+    } else if constexpr (std::is_same_v<Pattern, IndependentPattern>) {
+        fixed(SamplerKind::independent);
+        return IndependentPattern(layout.samples_per_pixel, layout.seed);
+    } else if constexpr (std::is_same_v<Pattern, StratifiedPattern>) {
+        fixed(SamplerKind::stratified);
+        return StratifiedPattern(layout.samples_per_pixel, layout.seed);
+    } else {
+        static_assert(std::is_same_v<Pattern, ZSobolPattern>, "a sampler policy is one of the four patterns");
+        fixed(SamplerKind::sobol);
+        return ZSobolPattern(layout.samples_per_pixel, layout.width, layout.height, layout.seed);
+    }
+}
+
+// Whether a pattern's pixel samplers draw each pixel's samples from one stream, one after
+// another (the independent sampler): the renderer then draws the camera samples from the stream
+// first, stratified across the pixel (camera/pixel_sampler.hpp), as it always has; the other
+// samplers take each sample's camera sample from its own first dimensions.
+template <class Pattern>
+bool streamed(const Pattern& pattern) {
+    if constexpr (std::is_same_v<Pattern, IndependentPattern>) return true;
+    else if constexpr (requires { pattern.streamed(); }) return pattern.streamed();
+    else return false;
+}
+
+}  // namespace prism
