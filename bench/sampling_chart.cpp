@@ -29,6 +29,7 @@
 #include <tbb/info.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -40,6 +41,7 @@
 #include <iostream>
 #include <memory>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <stdexcept>
@@ -49,6 +51,9 @@
 
 #ifndef PRISM_SHARED_DIR
 #define PRISM_SHARED_DIR "../shared"
+#endif
+#ifndef PRISM_SOURCE_DIR
+#define PRISM_SOURCE_DIR "."
 #endif
 
 namespace {
@@ -132,7 +137,9 @@ struct Options {
     std::vector<int> samples{1, 4, 16, 64, 256};
     int reference_samples = 8192;
     int runs = 3;
+    prism::SamplerKind sampler = prism::SamplerKind::independent;  // the RendererParams chart's
     fs::path shared = PRISM_SHARED_DIR;
+    fs::path project = PRISM_SOURCE_DIR;
     fs::path output_dir = "bench/chart";
     fs::path results;
     std::string command;
@@ -144,16 +151,25 @@ struct Options {
 
 // Relative RMSE: the root mean square difference over every channel of every pixel, divided by
 // the reference's mean. Dimensionless, so scenes of different brightness share one axis.
-double relative_rmse(const prism::Image& image, const prism::Image& reference) {
-    double square = 0, mean = 0;
+// `trimmed`: the fraction of the largest squared differences left out (fireflies: a path through
+// glass to the light that one sample in millions takes, whose one pixel can outweigh the rest of
+// the image; see samplers_markdown).
+double relative_rmse(const prism::Image& image, const prism::Image& reference, double trimmed = 0) {
+    std::vector<double> squares;
+    squares.reserve(3 * image.pixels.size());
+    double mean = 0;
     for (std::size_t p = 0; p < image.pixels.size(); ++p)
         for (int c = 0; c < 3; ++c) {
             const double d = double(image.pixels[p][c]) - double(reference.pixels[p][c]);
-            square += d * d;
+            squares.push_back(d * d);
             mean += double(reference.pixels[p][c]);
         }
-    const double n = 3.0 * double(image.pixels.size());
-    return std::sqrt(square / n) / (mean / n);
+    const double n = double(squares.size());
+    const auto kept = squares.size() - std::size_t(trimmed * n);
+    std::nth_element(squares.begin(), squares.begin() + std::ptrdiff_t(kept) - 1, squares.end());
+    double square = 0;
+    for (std::size_t i = 0; i < kept; ++i) square += squares[i];
+    return std::sqrt(square / double(kept)) / (mean / n);
 }
 
 
@@ -205,9 +221,9 @@ SceneResult measure_scene(const ChartScene& chart_scene, const Options& options)
     const prism::scene::Camera half =
         variant_camera(camera, variants()[reference_variant], std::max(1, options.reference_samples / 2));
     const ChartRenderer first(scene, prism::RendererSettings{prism::BackfaceCulling::triangles,
-                                                              prism::RayOffset::scene_epsilon, 1});
+                                                              prism::RayOffset::scene_epsilon, 1, {}});
     const ChartRenderer second(scene, prism::RendererSettings{prism::BackfaceCulling::triangles,
-                                                               prism::RayOffset::scene_epsilon, 2});
+                                                               prism::RayOffset::scene_epsilon, 2, {}});
     const prism::Image a = first.render(half, result.width, result.height);
     const prism::Image b = second.render(half, result.width, result.height);
     if (!finite(a) || !finite(b)) fail(chart_scene.name + ": the reference has a pixel that is not finite");
@@ -221,7 +237,7 @@ SceneResult measure_scene(const ChartScene& chart_scene, const Options& options)
               << std::setprecision(5) << result.reference_error << std::defaultfloat << "\n";
 
     const ChartRenderer renderer(scene, prism::RendererSettings{prism::BackfaceCulling::triangles,
-                                                                 prism::RayOffset::scene_epsilon, 0});
+                                                                 prism::RayOffset::scene_epsilon, 0, options.sampler});
     const std::size_t count = variants().size();
     result.points.assign(count, std::vector<Point>(options.samples.size()));
     std::vector<std::size_t> order(count);
@@ -275,29 +291,232 @@ double efficiency(const Point& point, double reference_error) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The chart (SVG): one panel per scene, CPU time on a log x axis, relative RMSE on a log y axis,
-// one line per variant through its sample counts.
+// The samplers (issue 32): each scene rendered as its first camera asks (its own integrator and
+// RendererParams), through the shipped renderers (prism::render_scene, as `prism` renders it),
+// with each sampler at each sample count, against a long independent render.
 
-void write_svg(const fs::path& path, const std::vector<SceneResult>& results, const Options& options,
-               const std::vector<std::string>& subtitle) {
+const std::vector<Variant>& sampler_styles() {  // in SamplerKind's order
+    static const std::vector<Variant> list{
+        {"independent: the pixel's PCG32 stream", "circle", "#777777", {}},
+        {"stratified: every dimension, pairs multi-jittered", "square", "#0072B2", {}},
+        {"sobol: Owen-scrambled Sobol', pixels in Morton order (ZSobol)", "diamond", "#D55E00", {}},
+    };
+    return list;
+}
+constexpr std::array all_samplers{prism::SamplerKind::independent, prism::SamplerKind::stratified,
+                                  prism::SamplerKind::sobol};
+
+// in_project: the file is under the project's own scenes/, not ../shared.
+struct SamplerScene {
+    std::string name;
+    std::string file;
+    bool in_project = false;
+};
+
+// Area lights and glossy reflections under the ray tracer, an object light seen by glossy
+// surfaces, the path tracer through glass, and an environment light. ../shared has no course
+// scene with an environment light (hw5's are not among its files), so that one is prism's own
+// scene in the course's format (a SphericalDirectionalLight, importance-sampled).
+const std::vector<SamplerScene>& sampler_scenes() {
+    static const std::vector<SamplerScene> list{
+        {"hw3 metal_plates_area: area lights, glossy metal, ray traced",
+         "ceng795/hw3/2018S_emrebarisc/Sources/3 - Instancing, Transformation, Distribution/Scenes/metal_plates_area.xml"},
+        {"glossy_area_small: LightMesh, glossy, ray traced",
+         hw7_inputs + "directLighting/inputs/cornellbox_jaroslav_glossy_area_small.xml"},
+        {"path_glass: path traced (NextEventEstimation)",
+         hw7_inputs + "pathTracing/inputs/cornellbox_jaroslav_path_glass.xml"},
+        {"environment/latlong: SphericalDirectionalLight", "scenes/environment/latlong.xml", true},
+    };
+    return list;
+}
+
+fs::path sampler_scene_path(const SamplerScene& chart_scene, const Options& options) {
+    return (chart_scene.in_project ? options.project : options.shared) / chart_scene.file;
+}
+
+// The share of squared differences the samplers' errors leave out (relative_rmse): one in a
+// thousand. path_glass's 64 x 64 pixels at 16 samples had a relative RMSE of 0.67-3.0 with
+// independent samples over seeds 0-3 and 0.55-0.69 without them; at such a spread one render's RMSE
+// ranks fireflies, not samplers.
+constexpr double firefly_share = 0.001;
+
+struct SamplerResult {
+    std::vector<std::vector<Point>> points;  // [sampler][sample count]; time: the camera's render, wall
+    int width = 0, height = 0;
+    double reference_error = 0;
+};
+
+// One render of the scene's first camera, as `prism` renders it with these options.
+prism::CameraImage render_first_camera(const prism::scene::Scene& scene, const Options& options, int samples,
+                                       std::uint64_t seed, prism::SamplerKind sampler) {
+    prism::RenderOptions render;
+    render.resolution_scale = options.scale;
+    render.samples = samples;
+    render.seed = seed;
+    render.sampler = sampler;
+    std::ostringstream log;  // the configuration's report: the same for every render
+    std::vector<prism::CameraImage> images = prism::render_scene(scene, render, log);
+    if (images.size() != 1) fail("expected one camera's image");
+    return std::move(images.front());
+}
+
+SamplerResult measure_samplers(const SamplerScene& chart_scene, const Options& options) {
+    prism::scene::Scene scene = prism::io::load_scene(sampler_scene_path(chart_scene, options));
+    if (scene.cameras.empty()) fail(chart_scene.name + ": the scene has no camera");
+    scene.cameras.resize(1);
+    SamplerResult result;
+    const auto reference_start = Clock::now();
+    const int half = std::max(1, options.reference_samples / 2);
+    const prism::Image a = render_first_camera(scene, options, half, 1, prism::SamplerKind::independent).image;
+    const prism::Image b = render_first_camera(scene, options, half, 2, prism::SamplerKind::independent).image;
+    if (!finite(a) || !finite(b)) fail(chart_scene.name + ": the reference has a pixel that is not finite");
+    prism::Image reference(a.width, a.height);
+    for (std::size_t p = 0; p < reference.pixels.size(); ++p) reference.pixels[p] = 0.5f * (a.pixels[p] + b.pixels[p]);
+    result.width = a.width;
+    result.height = a.height;
+    result.reference_error = 0.5 * relative_rmse(a, b, firefly_share);
+    std::cerr << chart_scene.name << ": " << result.width << "x" << result.height << "; reference "
+              << 2 * half << " samples per pixel in " << std::fixed << std::setprecision(1)
+              << seconds_since(reference_start) << " s wall, own relative RMSE " << std::setprecision(5)
+              << result.reference_error << std::defaultfloat << "\n";
+    result.points.assign(all_samplers.size(), std::vector<Point>(options.samples.size()));
+    std::vector<std::size_t> order(all_samplers.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::mt19937 shuffle(11);
+    for (std::size_t s = 0; s < options.samples.size(); ++s) {
+        std::vector<prism::Image> images(all_samplers.size());
+        for (int round = 0; round <= options.runs; ++round) {
+            std::shuffle(order.begin(), order.end(), shuffle);
+            for (const std::size_t k : order) {
+                prism::CameraImage render = render_first_camera(scene, options, options.samples[s], 0, all_samplers[k]);
+                const std::string name = chart_scene.name + ", " + std::string(prism::sampler_name(all_samplers[k])) +
+                                         ", " + std::to_string(options.samples[s]) + " samples";
+                if (round == 0) {
+                    if (!finite(render.image)) fail(name + ": a pixel is not finite");
+                    images[k] = std::move(render.image);
+                    continue;
+                }
+                if (!prism::same_bits(render.image, images[k]))
+                    fail(name + ": run " + std::to_string(round) + " rendered a different image from the first");
+                result.points[k][s].cpu.seconds.push_back(render.seconds);
+            }
+        }
+        for (std::size_t k = 0; k < all_samplers.size(); ++k) {
+            result.points[k][s].samples = options.samples[s];
+            result.points[k][s].error = relative_rmse(images[k], reference, firefly_share);
+        }
+    }
+    for (std::size_t k = 0; k < all_samplers.size(); ++k) {
+        std::cerr << "  " << std::left << std::setw(12) << prism::sampler_name(all_samplers[k]) << std::right;
+        for (const Point& point : result.points[k])
+            std::cerr << " " << std::setw(5) << point.samples << ": " << std::setprecision(4) << point.error << " in "
+                      << std::setprecision(3) << 1e3 * point.cpu.median() << " ms;";
+        std::cerr << std::defaultfloat << "\n";
+    }
+    return result;
+}
+
+// A sampler's own error at a point (the reference's share taken out, as in efficiency), over
+// independent's at the same sample count.
+double error_ratio(const SamplerResult& result, std::size_t sampler, std::size_t count) {
+    const auto own = [&](const Point& point) {
+        return std::sqrt(std::max(point.error * point.error - result.reference_error * result.reference_error, 0.0));
+    };
+    const double independent = own(result.points[0][count]);
+    return independent > 0 ? own(result.points[sampler][count]) / independent : 0.0;
+}
+
+std::string samplers_markdown(const std::vector<SamplerResult>& results, const Options& options,
+                              const std::string& date) {
+    std::ostringstream md;
+    md << "Written by the same command on " << date << " (revision `" << options.revision
+       << "`), after the RendererParams chart. Each scene's first camera, rendered as `prism` renders it "
+          "(`prism::render_scene`: its own integrator and RendererParams, the shipped renderers) at `--scale "
+       << options.scale << "`, with `--samples N --sampler S`; the reference: independent samples at "
+       << options.reference_samples
+       << " samples per pixel, as two halves (seeds 1 and 2; the curves use seed 0). Error: relative RMSE "
+          "without the largest 0.1% of squared differences (fireflies: one render's full RMSE on path_glass "
+          "ranged over 0.67-3.0 between seeds). Time: the camera's render (wall, " << tbb::info::default_concurrency()
+       << " threads, loading and the BVH's build left out), median of " << options.runs
+       << " runs after a warm-up, samplers interleaved. Every render repeated its first image bit for bit, every "
+          "pixel is finite, every curve's error fell from the lowest sample count to the highest, and each reference's "
+          "own error is at most a third of the smallest error shown.\n\n";
+    md << "![samplers: error against time](chart/samplers.png)\n\n";
+    md << "| scene | sampler |";
+    for (const int n : options.samples) md << " " << n << " spp: error, ms |";
+    md << " own error / independent's, 16 and 64 spp | time / independent's, highest count |\n|---|---|";
+    for (std::size_t i = 0; i < options.samples.size(); ++i) md << "---|";
+    md << "---|---|\n";
+    const auto index_of = [&](int count) {
+        const auto at = std::find(options.samples.begin(), options.samples.end(), count);
+        return at == options.samples.end() ? std::optional<std::size_t>{}
+                                           : std::optional<std::size_t>{std::size_t(at - options.samples.begin())};
+    };
+    for (std::size_t s = 0; s < results.size(); ++s) {
+        const SamplerResult& result = results[s];
+        for (std::size_t k = 0; k < all_samplers.size(); ++k) {
+            md << "| " << (k == 0 ? sampler_scenes()[s].name + " (" + std::to_string(result.width) + "x" +
+                                        std::to_string(result.height) + ")"
+                                  : std::string())
+               << " | " << prism::sampler_name(all_samplers[k]) << " |";
+            for (const Point& point : result.points[k])
+                md << " " << format_number(point.error, 3) << ", " << std::fixed << std::setprecision(1)
+                   << 1e3 * point.cpu.median() << std::defaultfloat << " |";
+            std::string ratios;
+            for (const int count : {16, 64})
+                if (const auto i = index_of(count))
+                    ratios += (ratios.empty() ? "" : ", ") + format_number(error_ratio(result, k, *i), 3);
+            md << " " << (ratios.empty() ? std::string("-") : ratios) << " | "
+               << format_number(result.points[k].back().cpu.median() / result.points[0].back().cpu.median(), 3)
+               << " |\n";
+        }
+    }
+    return md.str();
+}
+
+// ---------------------------------------------------------------------------------------------
+// The charts (SVG): one panel per scene, time on a log x axis, relative RMSE on a log y axis, one
+// line per curve (a RendererParams variant, or a sampler) through its sample counts.
+
+struct Curve {
+    const Variant* style = nullptr;  // name, marker and colour
+    const std::vector<Point>* points = nullptr;
+};
+
+struct Panel {
+    std::string name;
+    double reference_error = 0;
+    std::vector<Curve> curves;
+};
+
+struct Figure {
+    std::string title;
+    std::vector<std::string> subtitle;
+    std::string time_axis;      // what the x axis measures
+    std::string legend_title;
+    std::vector<Variant> legend;
+    std::string footnote;
+};
+
+void write_svg(const fs::path& path, const std::vector<Panel>& panels, const Figure& figure) {
     const double panel_width = 520, panel_height = 420, top = 110;
-    const double width = 90 + double(results.size()) * (panel_width + 110), height = 900;
+    const double width = 90 + double(panels.size()) * (panel_width + 110), height = 900;
     std::ostringstream svg;
     svg << std::fixed << std::setprecision(1);
     svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
         << "\" viewBox=\"0 0 " << width << " " << height << "\" font-family=\"DejaVu Sans, Arial, sans-serif\">\n";
     svg << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
     svg << "<text x=\"" << width / 2 << "\" y=\"32\" font-size=\"20\" text-anchor=\"middle\" font-weight=\"bold\">"
-        << "prism: error against time of the path tracer's sampling strategies</text>\n";
-    for (std::size_t line = 0; line < subtitle.size(); ++line)
+        << escape_xml(figure.title) << "</text>\n";
+    for (std::size_t line = 0; line < figure.subtitle.size(); ++line)
         svg << "<text x=\"" << width / 2 << "\" y=\"" << 54 + 17 * double(line)
-            << "\" font-size=\"13\" text-anchor=\"middle\">" << escape_xml(subtitle[line]) << "</text>\n";
-    for (std::size_t s = 0; s < results.size(); ++s) {
-        const SceneResult& result = results[s];
+            << "\" font-size=\"13\" text-anchor=\"middle\">" << escape_xml(figure.subtitle[line]) << "</text>\n";
+    for (std::size_t s = 0; s < panels.size(); ++s) {
+        const Panel& panel = panels[s];
         const double left = 90 + double(s) * (panel_width + 110);
-        std::vector<double> times, errors{result.reference_error};
-        for (const auto& curve : result.points)
-            for (const Point& point : curve) {
+        std::vector<double> times, errors{panel.reference_error};
+        for (const Curve& curve : panel.curves)
+            for (const Point& point : *curve.points) {
                 times.push_back(point.cpu.median());
                 errors.push_back(point.error);
             }
@@ -314,8 +533,8 @@ void write_svg(const fs::path& path, const std::vector<SceneResult>& results, co
                    (d - y_axis.floor_decade) / double(y_axis.top_decade - y_axis.floor_decade) * panel_height;
         };
         svg << "<text x=\"" << left + panel_width / 2 << "\" y=\"" << top - 10
-            << "\" font-size=\"13\" text-anchor=\"middle\" font-weight=\"bold\">"
-            << escape_xml(chart_scenes()[s].name) << "</text>\n";
+            << "\" font-size=\"13\" text-anchor=\"middle\" font-weight=\"bold\">" << escape_xml(panel.name)
+            << "</text>\n";
         svg << "<rect x=\"" << left << "\" y=\"" << top << "\" width=\"" << panel_width << "\" height=\""
             << panel_height << "\" fill=\"none\" stroke=\"#333\"/>\n";
         for (int d = y_axis.floor_decade; d <= y_axis.top_decade; ++d) {
@@ -330,40 +549,37 @@ void write_svg(const fs::path& path, const std::vector<SceneResult>& results, co
                 << "\" stroke=\"#ddd\"/>\n<text x=\"" << x << "\" y=\"" << top + panel_height + 18
                 << "\" font-size=\"12\" text-anchor=\"middle\">" << decade_label(d, false) << "</text>\n";
         }
-        // The reference's own error: a floor no variant can go below in this measurement.
-        const double floor_y = y_of(result.reference_error);
+        // The reference's own error: a floor no curve can go below in this measurement.
+        const double floor_y = y_of(panel.reference_error);
         svg << "<line x1=\"" << left << "\" y1=\"" << floor_y << "\" x2=\"" << left + panel_width << "\" y2=\""
             << floor_y << "\" stroke=\"#999\" stroke-dasharray=\"4,3\"/>\n<text x=\"" << left + panel_width - 4
             << "\" y=\"" << floor_y - 5 << "\" font-size=\"11\" text-anchor=\"end\" fill=\"#666\">the reference's own error</text>\n";
         svg << "<text x=\"" << left + panel_width / 2 << "\" y=\"" << top + panel_height + 42
-            << "\" font-size=\"13\" text-anchor=\"middle\">render CPU time, seconds (log scale)</text>\n";
+            << "\" font-size=\"13\" text-anchor=\"middle\">" << escape_xml(figure.time_axis) << "</text>\n";
         svg << "<text transform=\"translate(" << left - 62 << "," << top + panel_height / 2
             << ") rotate(-90)\" font-size=\"13\" text-anchor=\"middle\">relative RMSE against the reference (log scale)</text>\n";
-        for (std::size_t v = 0; v < variants().size(); ++v) {
-            const Variant& variant = variants()[v];
-            svg << "<polyline fill=\"none\" stroke=\"" << variant.colour << "\" stroke-width=\"1.5\" points=\"";
-            for (const Point& point : result.points[v]) svg << x_of(point.cpu.median()) << "," << y_of(point.error) << " ";
+        for (const Curve& curve : panel.curves) {
+            const Variant& style = *curve.style;
+            svg << "<polyline fill=\"none\" stroke=\"" << style.colour << "\" stroke-width=\"1.5\" points=\"";
+            for (const Point& point : *curve.points) svg << x_of(point.cpu.median()) << "," << y_of(point.error) << " ";
             svg << "\"/>\n";
-            for (const Point& point : result.points[v])
-                svg << marker_svg(variant.marker, x_of(point.cpu.median()), y_of(point.error), variant.colour) << "\n";
+            for (const Point& point : *curve.points)
+                svg << marker_svg(style.marker, x_of(point.cpu.median()), y_of(point.error), style.colour) << "\n";
         }
     }
     const double legend_top = top + panel_height + 80;
-    svg << "<text x=\"90\" y=\"" << legend_top << "\" font-size=\"14\" font-weight=\"bold\">RendererParams</text>\n";
-    for (std::size_t v = 0; v < variants().size(); ++v) {
+    svg << "<text x=\"90\" y=\"" << legend_top << "\" font-size=\"14\" font-weight=\"bold\">"
+        << escape_xml(figure.legend_title) << "</text>\n";
+    for (std::size_t v = 0; v < figure.legend.size(); ++v) {
+        const Variant& style = figure.legend[v];
         const double x = 90 + double(v / 5) * 520, y = legend_top + 24 + 24 * double(v % 5);
         svg << "<line x1=\"" << x - 4 << "\" y1=\"" << y - 4 << "\" x2=\"" << x + 24 << "\" y2=\"" << y - 4
-            << "\" stroke=\"" << variants()[v].colour << "\" stroke-width=\"1.5\"/>"
-            << marker_svg(variants()[v].marker, x + 10, y - 4, variants()[v].colour) << "<text x=\"" << x + 34
-            << "\" y=\"" << y << "\" font-size=\"13\">" << escape_xml(variants()[v].name) << "</text>\n";
+            << "\" stroke=\"" << style.colour << "\" stroke-width=\"1.5\"/>"
+            << marker_svg(style.marker, x + 10, y - 4, style.colour) << "<text x=\"" << x + 34 << "\" y=\"" << y
+            << "\" font-size=\"13\">" << escape_xml(style.name) << "</text>\n";
     }
-    std::string counts;
-    for (const int n : options.samples) counts += (counts.empty() ? "" : ", ") + std::to_string(n);
     svg << "<text x=\"90\" y=\"" << legend_top + 160 << "\" font-size=\"12\" fill=\"#444\">"
-        << escape_xml("Each line joins one variant's renders at " + counts +
-                      " samples per pixel (left to right); time: median of " + std::to_string(options.runs) +
-                      " interleaved runs, process CPU time.")
-        << "</text>\n";
+        << escape_xml(figure.footnote) << "</text>\n";
     svg << "</svg>\n";
     std::ofstream out(path);
     out << svg.str();
@@ -444,11 +660,14 @@ const char* usage =
     "usage: prism_sampling_chart [--scale S] [--samples N,N,...] [--reference-samples N] [--runs N]\n"
     "                            [--shared DIR] [--output-dir DIR] [--results RESULTS.md] [--command TEXT]\n"
     "                            [--revision TEXT]\n"
-    "Renders the chart's Cornell boxes with every path-tracing variant at each sample count, measures\n"
-    "each image's relative RMSE against a long MIS render, and times the renders. Writes\n"
-    "DIR/sampling.svg, DIR/sampling.tsv and DIR/sampling.md, and replaces the marked section of\n"
-    "RESULTS.md when given. Defaults: --scale 0.125, --samples 1,4,16,64,256, --reference-samples 8192,\n"
-    "--runs 3 (timed runs after one warm-up), --shared " PRISM_SHARED_DIR ".\n";
+    "                            [--sampler independent|stratified|sobol] [--project DIR]\n"
+    "Renders the chart's Cornell boxes with every path-tracing variant at each sample count (with\n"
+    "--sampler's samples), measures each image's relative RMSE against a long MIS render, and times\n"
+    "the renders; then renders four scenes as prism renders them with each sampler at each count,\n"
+    "against a long independent render. Writes DIR/sampling.svg, DIR/samplers.svg, DIR/sampling.tsv\n"
+    "and DIR/sampling.md, and replaces the marked section of RESULTS.md when given. Defaults:\n"
+    "--scale 0.125, --samples 1,4,16,64,256, --reference-samples 8192, --runs 3 (timed runs after one\n"
+    "warm-up), --sampler independent, --shared " PRISM_SHARED_DIR ", --project " PRISM_SOURCE_DIR ".\n";
 
 std::vector<int> parse_counts(const std::string& text) {
     std::vector<int> counts;
@@ -478,6 +697,13 @@ Options parse(int argc, char** argv) {
         else if (arg == "--reference-samples") options.reference_samples = std::stoi(value());
         else if (arg == "--runs") options.runs = std::stoi(value());
         else if (arg == "--shared") options.shared = value();
+        else if (arg == "--project") options.project = value();
+        else if (arg == "--sampler") {
+            const std::string name = value();
+            const std::optional<prism::SamplerKind> kind = prism::parse_sampler(name);
+            if (!kind) fail("--sampler must be independent, stratified or sobol, not \"" + name + "\"");
+            options.sampler = *kind;
+        }
         else if (arg == "--output-dir") options.output_dir = value();
         else if (arg == "--results") options.results = value();
         else if (arg == "--command") options.command = value();
@@ -506,8 +732,14 @@ int run(int argc, char** argv) {
     require_files(options.shared, files);
     fs::create_directories(options.output_dir);
 
+    for (const SamplerScene& chart_scene : sampler_scenes())
+        if (!fs::exists(sampler_scene_path(chart_scene, options)))
+            fail(chart_scene.name + ": " + sampler_scene_path(chart_scene, options).string() + " not found");
     std::vector<SceneResult> results;
     for (const ChartScene& chart_scene : chart_scenes()) results.push_back(measure_scene(chart_scene, options));
+    std::vector<SamplerResult> sampler_results;
+    for (const SamplerScene& chart_scene : sampler_scenes())
+        sampler_results.push_back(measure_samplers(chart_scene, options));
 
     // The answers, before anything is written.
     for (std::size_t s = 0; s < results.size(); ++s) {
@@ -527,6 +759,24 @@ int run(int argc, char** argv) {
                  " is more than a third of the smallest error measured (" + format_number(smallest, 3) +
                  "): raise --reference-samples");
     }
+    for (std::size_t s = 0; s < sampler_results.size(); ++s) {
+        const SamplerResult& result = sampler_results[s];
+        double smallest = INFINITY;
+        for (std::size_t k = 0; k < all_samplers.size(); ++k) {
+            const std::vector<Point>& curve = result.points[k];
+            smallest = std::min(smallest, curve.back().error);
+            if (!(curve.back().error < curve.front().error))
+                fail(sampler_scenes()[s].name + ", " + std::string(prism::sampler_name(all_samplers[k])) +
+                     ": the error did not fall from " + std::to_string(curve.front().samples) + " to " +
+                     std::to_string(curve.back().samples) + " samples per pixel (" +
+                     format_number(curve.front().error, 4) + " to " + format_number(curve.back().error, 4) +
+                     "): it converges to another image than the reference");
+        }
+        if (result.reference_error * 3 > smallest)
+            fail(sampler_scenes()[s].name + ": the reference's own error " + format_number(result.reference_error, 3) +
+                 " is more than a third of the smallest error measured (" + format_number(smallest, 3) +
+                 "): raise --reference-samples");
+    }
     const std::vector<std::string> checks{
         "every variant rendered the same image bit for bit in each of its runs, and every pixel is finite;",
         "every variant's error fell from the lowest sample count to the highest (none converges elsewhere);",
@@ -539,9 +789,38 @@ int run(int argc, char** argv) {
             " samples per pixel; render CPU time, median of " + std::to_string(options.runs) + " runs",
         std::to_string(results.front().width) + "x" + std::to_string(results.front().height) + " pixels; " +
             std::to_string(tbb::info::default_concurrency()) + " threads; " + cpu_model() + "; " + date};
-    write_svg(options.output_dir / "sampling.svg", results, options, subtitle);
+    std::vector<Panel> panels;
+    for (std::size_t s = 0; s < results.size(); ++s) {
+        Panel panel{chart_scenes()[s].name, results[s].reference_error, {}};
+        for (std::size_t v = 0; v < variants().size(); ++v) panel.curves.push_back({&variants()[v], &results[s].points[v]});
+        panels.push_back(std::move(panel));
+    }
+    write_svg(options.output_dir / "sampling.svg", panels,
+              {"prism: error against time of the path tracer's sampling strategies", subtitle,
+               "render CPU time, seconds (log scale)", "RendererParams", variants(),
+               "Each line joins one variant's renders at " + counts +
+                   " samples per pixel (left to right); time: median of " + std::to_string(options.runs) +
+                   " interleaved runs, process CPU time; sampler: " +
+                   std::string(prism::sampler_name(options.sampler)) + "."});
+    std::vector<Panel> sampler_panels;
+    for (std::size_t s = 0; s < sampler_results.size(); ++s) {
+        Panel panel{sampler_scenes()[s].name, sampler_results[s].reference_error, {}};
+        for (std::size_t k = 0; k < all_samplers.size(); ++k)
+            panel.curves.push_back({&sampler_styles()[k], &sampler_results[s].points[k]});
+        sampler_panels.push_back(std::move(panel));
+    }
+    write_svg(options.output_dir / "samplers.svg", sampler_panels,
+              {"prism: error against time of its samplers", 
+               {"relative RMSE against a " + std::to_string(options.reference_samples) +
+                    "-sample independent render, the largest 0.1% of squared differences left out; " + counts +
+                    " samples per pixel",
+                subtitle[1]},
+               "render time of the camera, wall seconds (log scale)", "--sampler", sampler_styles(),
+               "Each line joins one sampler's renders at " + counts + " samples per pixel (left to right); time: median of " +
+                   std::to_string(options.runs) + " interleaved runs of the camera's render (wall)."});
     write_tsv(options.output_dir / "sampling.tsv", results);
-    const std::string section = markdown_section(results, options, seconds_since(start), start_load, date, checks);
+    const std::string section = markdown_section(results, options, seconds_since(start), start_load, date, checks) +
+                                "\n### The samplers (issue 32)\n\n" + samplers_markdown(sampler_results, options, date);
     {
         std::ofstream out(options.output_dir / "sampling.md");
         out << section;

@@ -423,3 +423,15 @@ TEST_CASE_TEMPLATE("Samplers: a Config that fixes its sampler renders what the r
     // And the sampler matters: the independent image differs.
     CHECK(prism::Renderer<Chosen>(world, other).render(world.cameras[0]).pixels != fixed.pixels);
 }
+
+TEST_CASE("Samplers: Sobol' dimension 1 by byte tables equals it bit by bit") {
+    std::uint32_t index = 0x12345678u;
+    int differ = 0;
+    for (int i = 0; i < 4096; ++i) {
+        differ += prism::sampling::sobol_dimension1(std::uint32_t(i)) != prism::sampling::sobol_dimension1_bitwise(std::uint32_t(i));
+        index = index * 1664525u + 1013904223u;
+        differ += prism::sampling::sobol_dimension1(index) != prism::sampling::sobol_dimension1_bitwise(index);
+    }
+    CHECK(differ == 0);
+    CHECK(prism::sampling::sobol_dimension1(0xffffffffu) == prism::sampling::sobol_dimension1_bitwise(0xffffffffu));
+}

@@ -39,26 +39,49 @@ constexpr std::uint32_t sobol_dimension0(std::uint32_t index) { return reverse_b
 
 // The second: its generator matrix is Pascal's triangle mod 2, whose column k (the direction
 // number of index bit k) is column k-1 XOR itself shifted one place down.
-constexpr std::uint32_t sobol_dimension1(std::uint32_t index) {
+constexpr std::uint32_t sobol_dimension1_bitwise(std::uint32_t index) {
     std::uint32_t result = 0;
     for (std::uint32_t direction = 0x80000000u; index != 0; index >>= 1, direction ^= direction >> 1)
         if (index & 1) result ^= direction;
     return result;
 }
 
+// The same by bytes, bit-reversed (as owen_scramble_reversed takes it): the matrix is linear over
+// GF(2), so the index's four bytes contribute independently, each looked up in a table of its 256
+// values (4 KB in all). One bit at a time, a sample's dimension 1 waited for up to 32 dependent
+// steps (with the index shuffle, a quarter of a path-traced render's time).
+constexpr std::array<std::array<std::uint32_t, 256>, 4> sobol_dimension1_tables() {
+    std::array<std::array<std::uint32_t, 256>, 4> tables{};
+    for (std::uint32_t byte = 0; byte < 4; ++byte)
+        for (std::uint32_t value = 0; value < 256; ++value)
+            tables[byte][value] = reverse_bits(sobol_dimension1_bitwise(value << (8 * byte)));
+    return tables;
+}
+inline constexpr std::array<std::array<std::uint32_t, 256>, 4> sobol_dimension1_table = sobol_dimension1_tables();
+
+constexpr std::uint32_t sobol_dimension1_reversed(std::uint32_t index) {
+    return sobol_dimension1_table[0][index & 0xff] ^ sobol_dimension1_table[1][(index >> 8) & 0xff] ^
+           sobol_dimension1_table[2][(index >> 16) & 0xff] ^ sobol_dimension1_table[3][index >> 24];
+}
+constexpr std::uint32_t sobol_dimension1(std::uint32_t index) { return reverse_bits(sobol_dimension1_reversed(index)); }
+
 // A nested uniform (Owen) scramble of a 32-bit fraction by hashing (Burley, "Practical Hash-based
 // Owen Scrambling", JCGT 2020): on the bit-reversed value, additions and multiplications carry
 // only towards higher bits, so each digit of the fraction is flipped by a function of the digits
 // before it and the seed alone. That permutes the elementary intervals at every level, so a net
 // stays a net.
-constexpr std::uint32_t owen_scramble(std::uint32_t v, std::uint32_t seed) {
-    v = reverse_bits(v);
+// owen_scramble of a fraction given bit-reversed (its first digit in bit 0): Sobol' dimension 0 of
+// index i is i reversed, so its scramble needs no reversal on the way in.
+constexpr std::uint32_t owen_scramble_reversed(std::uint32_t v, std::uint32_t seed) {
     v ^= v * 0x3d20adeau;
     v += seed;
     v *= (seed >> 16) | 1u;
     v ^= v * 0x05526c56u;
     v ^= v * 0x53a22864u;
     return reverse_bits(v);
+}
+constexpr std::uint32_t owen_scramble(std::uint32_t v, std::uint32_t seed) {
+    return owen_scramble_reversed(reverse_bits(v), seed);
 }
 
 // Morton order: x's bits in the even places, y's in the odd.
@@ -85,13 +108,17 @@ constexpr std::array<std::array<std::uint8_t, 4>, 24> base4_permutations() {
     }
     return all;
 }
+// At namespace scope, so that it is one table in memory, not built on the stack by every call.
+inline constexpr std::array<std::array<std::uint8_t, 4>, 24> base4_permutation_table = base4_permutations();
 
 }  // namespace sampling
 
 class ZSobolSampler {
 public:
     constexpr ZSobolSampler(std::uint64_t morton, int log2_samples, int base4_digits, std::uint64_t seed)
-        : morton_(morton), log2_samples_(log2_samples), base4_digits_(base4_digits), seed_(seed) {}
+        : morton_(morton), log2_samples_(log2_samples), base4_digits_(base4_digits),
+          single_base_(sampling::hash_key(0, seed, 1)), pair_base_(sampling::hash_key(0, seed, 2)),
+          salt_base_(sampling::hash_key(0, seed, 3)) {}
 
     constexpr void start_sample(int index) {
         index_ = (morton_ << log2_samples_) | std::uint64_t(std::uint32_t(index));
@@ -100,18 +127,20 @@ public:
 
     template <Scalar Real>
     constexpr Real uniform() {
-        const std::uint64_t key = sampling::hash_key(std::uint64_t(dimension_), seed_, 1);
-        const std::uint32_t bits = sampling::owen_scramble(sampling::sobol_dimension0(point_index()), std::uint32_t(key));
+        const std::uint64_t key = sampling::dimension_key(single_base_, dimension_);
+        // Dimension 0 of the index is the index reversed: scrambled as it is.
+        const std::uint32_t bits = sampling::owen_scramble_reversed(point_index(), std::uint32_t(key));
         ++dimension_;
         return sampling::unit_from_bits<Real>(bits);
     }
 
     template <Scalar Real>
     constexpr Vec2<Real> uniform2() {
-        const std::uint64_t key = sampling::hash_key(std::uint64_t(dimension_), seed_, 2);
+        const std::uint64_t key = sampling::dimension_key(pair_base_, dimension_);
         const std::uint32_t index = point_index();
-        const std::uint32_t x = sampling::owen_scramble(sampling::sobol_dimension0(index), std::uint32_t(key));
-        const std::uint32_t y = sampling::owen_scramble(sampling::sobol_dimension1(index), std::uint32_t(key >> 32));
+        const std::uint32_t x = sampling::owen_scramble_reversed(index, std::uint32_t(key));
+        const std::uint32_t y = sampling::owen_scramble_reversed(sampling::sobol_dimension1_reversed(index),
+                                                                 std::uint32_t(key >> 32));
         dimension_ += 2;
         return {sampling::unit_from_bits<Real>(x), sampling::unit_from_bits<Real>(y)};
     }
@@ -129,27 +158,58 @@ private:
     // the (original) digits above it, the dimension and the seed. With an odd log2 of the
     // sample count the lowest digit is base 2, flipped by a hash bit. Only the low 32 bits reach
     // a 32-bit fraction (sobol_dimension0/1), as in any 32-bit Sobol' generator.
-    constexpr std::uint32_t point_index() const {
-        constexpr auto permutations = sampling::base4_permutations();
+    // The digits of the pixel's Morton index (at and above first_pixel_digit) and the digits
+    // above them are the same for every sample of the pixel, so their shuffle is kept per
+    // dimension (pixel_digits) and each sample hashes only its own few digits: at 16 samples of
+    // a 128 x 128 image, 2 hashes a dimension instead of 9.
+    constexpr std::uint32_t point_index() {
         const bool odd = (log2_samples_ & 1) != 0;
-        const std::uint64_t salt = sampling::hash_key(std::uint64_t(dimension_), seed_, 3);
-        std::uint64_t shuffled = 0;
-        for (int digit = base4_digits_ - 1; digit >= (odd ? 1 : 0); --digit) {
-            const int shift = 2 * digit - (odd ? 1 : 0);
-            const std::uint64_t above = shift + 2 >= 64 ? 0 : index_ >> (shift + 2);
-            const std::uint64_t chosen = mix_bits(above ^ salt) >> 40;
-            const auto& permutation = permutations[std::size_t(chosen % 24)];
-            shuffled |= std::uint64_t(permutation[(index_ >> shift) & 3]) << shift;
-        }
+        const std::uint64_t salt = salt_of(dimension_);
+        std::uint64_t shuffled = pixel_digits(salt);
+        for (int digit = first_pixel_digit() - 1; digit >= (odd ? 1 : 0); --digit) shuffled |= shuffled_digit(digit, salt);
         if (odd) shuffled |= (index_ & 1) ^ (mix_bits((index_ >> 1) ^ salt) >> 63);
         return std::uint32_t(shuffled);
     }
 
+    constexpr std::uint64_t salt_of(int dimension) const {
+        return sampling::dimension_key(salt_base_, dimension);
+    }
+    // The lowest base-4 digit made of the pixel's bits alone (every digit below holds sample bits).
+    constexpr int first_pixel_digit() const { return (log2_samples_ + 1) / 2; }
+
+    // Base-4 digit `digit` of the index, shuffled, in its place.
+    constexpr std::uint64_t shuffled_digit(int digit, std::uint64_t salt) const {
+        const int shift = 2 * digit - (log2_samples_ & 1);
+        const std::uint64_t above = shift + 2 >= 64 ? 0 : index_ >> (shift + 2);
+        const std::uint64_t chosen = mix_bits(above ^ salt) >> 40;
+        const auto& permutation = sampling::base4_permutation_table[std::size_t(chosen % 24)];
+        return std::uint64_t(permutation[(index_ >> shift) & 3]) << shift;
+    }
+
+    constexpr std::uint64_t pixel_digits(std::uint64_t salt) {
+        const bool cached = dimension_ >= 0 && dimension_ < cached_dimensions;
+        const std::uint64_t bit = cached ? std::uint64_t(1) << dimension_ : 0;
+        if (cached && (known_ & bit)) return pixel_digits_[std::size_t(dimension_)];
+        std::uint64_t shuffled = 0;
+        for (int digit = base4_digits_ - 1; digit >= first_pixel_digit(); --digit) shuffled |= shuffled_digit(digit, salt);
+        if (cached) {
+            pixel_digits_[std::size_t(dimension_)] = std::uint32_t(shuffled);
+            known_ |= bit;
+        }
+        return shuffled;
+    }
+
+    static constexpr int cached_dimensions = 64;
+
     std::uint64_t morton_;
     int log2_samples_, base4_digits_;
-    std::uint64_t seed_;
+    // The seed's hashes for single dimensions, pairs and the index shuffle's salt, which each
+    // dimension's keys start from (sampling::dimension_key).
+    std::uint64_t single_base_, pair_base_, salt_base_;
     std::uint64_t index_ = 0;
     int dimension_ = 0;
+    std::uint64_t known_ = 0;  // bit d: pixel_digits_[d] holds dimension d's
+    std::array<std::uint32_t, cached_dimensions> pixel_digits_;  // only the low 32 bits reach a point
 };
 
 // A render's ZSobol pattern: its sample count rounded up to a power of two for the index (the

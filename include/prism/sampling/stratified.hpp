@@ -52,9 +52,12 @@ constexpr Real below_one(double x) {
 class StratifiedSampler {
 public:
     constexpr StratifiedSampler(std::uint64_t pixel_key, int samples, std::uint64_t seed)
-        : pixel_key_(pixel_key), samples_(std::uint32_t(samples)), seed_(seed) {
+        : base_(sampling::hash_key(pixel_key, seed)), samples_(std::uint32_t(samples)) {
         while (columns_ * columns_ < samples_) ++columns_;
         rows_ = (samples_ + columns_ - 1) / columns_;
+        inverse_samples_ = 1.0 / samples_;
+        inverse_columns_ = 1.0 / columns_;
+        inverse_rows_ = 1.0 / rows_;
     }
 
     constexpr void start_sample(int index) {
@@ -68,7 +71,7 @@ public:
         const std::uint32_t stratum = sampling::permute_index(sample_, samples_, key);
         const double jitter = sampling::unit_from_bits<double>(std::uint32_t(mix_bits(key ^ sample_)));
         ++dimension_;
-        return sampling::below_one<Real>((stratum + jitter) / samples_);
+        return sampling::below_one<Real>((stratum + jitter) * inverse_samples_);
     }
 
     template <Scalar Real>
@@ -82,8 +85,8 @@ public:
         const double jx = sampling::unit_from_bits<double>(std::uint32_t(jitter_bits));
         const double jy = sampling::unit_from_bits<double>(std::uint32_t(jitter_bits >> 32));
         dimension_ += 2;
-        return {sampling::below_one<Real>((column + (sub_row + jx) / rows_) / columns_),
-                sampling::below_one<Real>((row + (sub_column + jy) / columns_) / rows_)};
+        return {sampling::below_one<Real>((column + (sub_row + jx) * inverse_rows_) * inverse_columns_),
+                sampling::below_one<Real>((row + (sub_column + jy) * inverse_columns_) * inverse_rows_)};
     }
 
     template <Scalar Real>
@@ -94,12 +97,13 @@ public:
     constexpr void seek(int dimension) { dimension_ = dimension; }
 
 private:
-    constexpr std::uint64_t dimension_key() const { return sampling::hash_key(pixel_key_, std::uint64_t(dimension_), seed_); }
+    constexpr std::uint64_t dimension_key() const { return sampling::dimension_key(base_, dimension_); }
 
-    std::uint64_t pixel_key_;
+    std::uint64_t base_;  // the pixel's and seed's hash, which each dimension's key starts from
     std::uint32_t samples_;
-    std::uint64_t seed_;
     std::uint32_t columns_ = 1, rows_ = 1;
+    // Multiplied rather than divided by: a sample's divisions waited one after another.
+    double inverse_samples_ = 1, inverse_columns_ = 1, inverse_rows_ = 1;
     std::uint32_t sample_ = 0;
     int dimension_ = 0;
 };
