@@ -814,7 +814,8 @@ int run(int argc, char** argv) {
                {"relative RMSE against a " + std::to_string(options.reference_samples) +
                     "-sample independent render, the largest 0.1% of squared differences left out; " + counts +
                     " samples per pixel",
-                subtitle[1]},
+                "each scene at " + format_number(options.scale, 3) + " of its resolution; " +
+                    std::to_string(tbb::info::default_concurrency()) + " threads; " + cpu_model() + "; " + date},
                "render time of the camera, wall seconds (log scale)", "--sampler", sampler_styles(),
                "Each line joins one sampler's renders at " + counts + " samples per pixel (left to right); time: median of " +
                    std::to_string(options.runs) + " interleaved runs of the camera's render (wall)."});

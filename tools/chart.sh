@@ -6,7 +6,8 @@
 #   bash tools/chart.sh [ARGS]           speed against accuracy of intersectors, precision and ray
 #                                        offsets (tracker issue 3): bench/chart/speed_accuracy.*
 #   bash tools/chart.sh sampling [ARGS]  error against time of the path tracer's sampling
-#                                        strategies (issue 13): bench/chart/sampling.*
+#                                        strategies (issue 13): bench/chart/sampling.*, and of
+#                                        the samplers (issue 32): bench/chart/samplers.*
 # ARGS go to the program: `bash tools/chart.sh --scale 0.25 --runs 3` is a quick look; `--help`
 # lists them.
 set -euo pipefail
@@ -39,4 +40,7 @@ command="bash tools/chart.sh"
 "build-chart/bench/$program" --output-dir bench/chart --results bench/RESULTS.md \
     --command "$command${*:+ $*}" --revision "$revision" "$@"
 rsvg-convert --format png --background-color white --output "bench/chart/$stem.png" "bench/chart/$stem.svg"
+if [[ "$chart" == "sampling" ]]; then
+  rsvg-convert --format png --background-color white --output bench/chart/samplers.png bench/chart/samplers.svg
+fi
 echo "wrote bench/chart/$stem.svg, bench/chart/$stem.png and the $chart chart's section of bench/RESULTS.md"
