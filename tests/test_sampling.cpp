@@ -480,11 +480,14 @@ TEST_CASE_TEMPLATE("Renderer: a pixel's samples lit side by side (radiances_at) 
         if (indexed) world.meshes.push_back(tent);
         for (const prism::RayOffset offset : {prism::RayOffset::scene_epsilon, prism::RayOffset::error_bound}) {
             CAPTURE(int(offset));
-            for (const auto& [count, kind] : {std::pair{5, prism::SamplerKind::independent},
-                                              std::pair{16, prism::SamplerKind::independent},
-                                              std::pair{40, prism::SamplerKind::independent},
-                                              std::pair{16, prism::SamplerKind::stratified},
-                                              std::pair{40, prism::SamplerKind::sobol}}) {
+            // (Named, not bound: clang 14's CAPTURE cannot capture a structured binding.)
+            for (const std::pair<int, prism::SamplerKind>& run : {std::pair{5, prism::SamplerKind::independent},
+                                                                  std::pair{16, prism::SamplerKind::independent},
+                                                                  std::pair{40, prism::SamplerKind::independent},
+                                                                  std::pair{16, prism::SamplerKind::stratified},
+                                                                  std::pair{40, prism::SamplerKind::sobol}}) {
+                const int count = run.first;
+                const prism::SamplerKind kind = run.second;
                 CAPTURE(count);
                 CAPTURE(prism::sampler_name(kind));
                 world.cameras[0].num_samples = count;
