@@ -498,6 +498,26 @@ struct Figure {
     std::string footnote;
 };
 
+// A panel's answers: every curve's error fell from its lowest sample count to its highest (one
+// converging to another image would level off), and the reference's own error is at most a third
+// of the smallest error shown (so the chart measures the curves, not the reference).
+void check_panel(const Panel& panel) {
+    double smallest = INFINITY;
+    for (const Curve& curve : panel.curves) {
+        const std::vector<Point>& points = *curve.points;
+        smallest = std::min(smallest, points.back().error);
+        if (!(points.back().error < points.front().error))
+            fail(panel.name + ", " + curve.style->name + ": the error did not fall from " +
+                 std::to_string(points.front().samples) + " to " + std::to_string(points.back().samples) +
+                 " samples per pixel (" + format_number(points.front().error, 4) + " to " +
+                 format_number(points.back().error, 4) + "): it converges to another image than the reference");
+    }
+    if (panel.reference_error * 3 > smallest)
+        fail(panel.name + ": the reference's own error " + format_number(panel.reference_error, 3) +
+             " is more than a third of the smallest error measured (" + format_number(smallest, 3) +
+             "): raise --reference-samples");
+}
+
 void write_svg(const fs::path& path, const std::vector<Panel>& panels, const Figure& figure) {
     const double panel_width = 520, panel_height = 420, top = 110;
     const double width = 90 + double(panels.size()) * (panel_width + 110), height = 900;
@@ -741,42 +761,22 @@ int run(int argc, char** argv) {
     for (const SamplerScene& chart_scene : sampler_scenes())
         sampler_results.push_back(measure_samplers(chart_scene, options));
 
-    // The answers, before anything is written.
+    std::vector<Panel> panels;
     for (std::size_t s = 0; s < results.size(); ++s) {
-        const SceneResult& result = results[s];
-        double smallest = INFINITY;
-        for (std::size_t v = 0; v < variants().size(); ++v) {
-            const std::vector<Point>& curve = result.points[v];
-            smallest = std::min(smallest, curve.back().error);
-            if (!(curve.back().error < curve.front().error))
-                fail(chart_scenes()[s].name + ", " + variants()[v].name + ": the error did not fall from " +
-                     std::to_string(curve.front().samples) + " to " + std::to_string(curve.back().samples) +
-                     " samples per pixel (" + format_number(curve.front().error, 4) + " to " +
-                     format_number(curve.back().error, 4) + "): it converges to another image than the reference");
-        }
-        if (result.reference_error * 3 > smallest)
-            fail(chart_scenes()[s].name + ": the reference's own error " + format_number(result.reference_error, 3) +
-                 " is more than a third of the smallest error measured (" + format_number(smallest, 3) +
-                 "): raise --reference-samples");
+        Panel panel{chart_scenes()[s].name, results[s].reference_error, {}};
+        for (std::size_t v = 0; v < variants().size(); ++v) panel.curves.push_back({&variants()[v], &results[s].points[v]});
+        panels.push_back(std::move(panel));
     }
+    std::vector<Panel> sampler_panels;
     for (std::size_t s = 0; s < sampler_results.size(); ++s) {
-        const SamplerResult& result = sampler_results[s];
-        double smallest = INFINITY;
-        for (std::size_t k = 0; k < all_samplers.size(); ++k) {
-            const std::vector<Point>& curve = result.points[k];
-            smallest = std::min(smallest, curve.back().error);
-            if (!(curve.back().error < curve.front().error))
-                fail(sampler_scenes()[s].name + ", " + std::string(prism::sampler_name(all_samplers[k])) +
-                     ": the error did not fall from " + std::to_string(curve.front().samples) + " to " +
-                     std::to_string(curve.back().samples) + " samples per pixel (" +
-                     format_number(curve.front().error, 4) + " to " + format_number(curve.back().error, 4) +
-                     "): it converges to another image than the reference");
-        }
-        if (result.reference_error * 3 > smallest)
-            fail(sampler_scenes()[s].name + ": the reference's own error " + format_number(result.reference_error, 3) +
-                 " is more than a third of the smallest error measured (" + format_number(smallest, 3) +
-                 "): raise --reference-samples");
+        Panel panel{sampler_scenes()[s].name, sampler_results[s].reference_error, {}};
+        for (std::size_t k = 0; k < all_samplers.size(); ++k)
+            panel.curves.push_back({&sampler_styles()[k], &sampler_results[s].points[k]});
+        sampler_panels.push_back(std::move(panel));
     }
+    // The answers, before anything is written.
+    for (const Panel& panel : panels) check_panel(panel);
+    for (const Panel& panel : sampler_panels) check_panel(panel);
     const std::vector<std::string> checks{
         "every variant rendered the same image bit for bit in each of its runs, and every pixel is finite;",
         "every variant's error fell from the lowest sample count to the highest (none converges elsewhere);",
@@ -789,12 +789,6 @@ int run(int argc, char** argv) {
             " samples per pixel; render CPU time, median of " + std::to_string(options.runs) + " runs",
         std::to_string(results.front().width) + "x" + std::to_string(results.front().height) + " pixels; " +
             std::to_string(tbb::info::default_concurrency()) + " threads; " + cpu_model() + "; " + date};
-    std::vector<Panel> panels;
-    for (std::size_t s = 0; s < results.size(); ++s) {
-        Panel panel{chart_scenes()[s].name, results[s].reference_error, {}};
-        for (std::size_t v = 0; v < variants().size(); ++v) panel.curves.push_back({&variants()[v], &results[s].points[v]});
-        panels.push_back(std::move(panel));
-    }
     write_svg(options.output_dir / "sampling.svg", panels,
               {"prism: error against time of the path tracer's sampling strategies", subtitle,
                "render CPU time, seconds (log scale)", "RendererParams", variants(),
@@ -802,13 +796,6 @@ int run(int argc, char** argv) {
                    " samples per pixel (left to right); time: median of " + std::to_string(options.runs) +
                    " interleaved runs, process CPU time; sampler: " +
                    std::string(prism::sampler_name(options.sampler)) + "."});
-    std::vector<Panel> sampler_panels;
-    for (std::size_t s = 0; s < sampler_results.size(); ++s) {
-        Panel panel{sampler_scenes()[s].name, sampler_results[s].reference_error, {}};
-        for (std::size_t k = 0; k < all_samplers.size(); ++k)
-            panel.curves.push_back({&sampler_styles()[k], &sampler_results[s].points[k]});
-        sampler_panels.push_back(std::move(panel));
-    }
     write_svg(options.output_dir / "samplers.svg", sampler_panels,
               {"prism: error against time of its samplers", 
                {"relative RMSE against a " + std::to_string(options.reference_samples) +

@@ -56,7 +56,7 @@ public:
         : whitted_(geometry, lights, materials, textures, environment, ambient_light, background, settings),
           geometry_(geometry), lights_(lights), materials_(materials), textures_(textures), environment_(environment),
           background_(background), settings_(settings), epsilon_(Real(settings.shadow_ray_epsilon)),
-          bounce_dimensions_(dimension::lights + 2 * count_lights(lights)) {
+          bounce_dimensions_(dimension::lights + 2 * int(lights.size())) {
         // Which object light each emitting object is, for the density of reaching it by
         // next-event estimation (multiple importance sampling).
         emitters_.assign(geometry.instance_count(), Emitter{});
@@ -142,12 +142,6 @@ private:
         static constexpr int specular_choice = 0, direction = 1, fresnel_choice = 3, transmitted = 4, roulette = 6,
                              lights = 7;
     };
-
-    static int count_lights(const LightSetT& lights) {
-        int count = 0;
-        lights.for_each([&](const auto&) { ++count; });
-        return count;
-    }
 
     struct Emitter {
         enum Type : std::uint8_t { none, mesh, sphere } type = none;

@@ -111,14 +111,19 @@ constexpr std::array<std::array<std::uint8_t, 4>, 24> base4_permutations() {
 // At namespace scope, so that it is one table in memory, not built on the stack by every call.
 inline constexpr std::array<std::array<std::uint8_t, 4>, 24> base4_permutation_table = base4_permutations();
 
+// The seed's hashes for single dimensions, pairs and the index shuffle's salt, which each
+// dimension's keys start from (dimension_key): hashed once a render, by the pattern.
+struct ZSobolKeys {
+    std::uint64_t single, pair, salt;
+    static constexpr ZSobolKeys of(std::uint64_t seed) { return {hash_key(0, seed, 1), hash_key(0, seed, 2), hash_key(0, seed, 3)}; }
+};
+
 }  // namespace sampling
 
 class ZSobolSampler {
 public:
-    constexpr ZSobolSampler(std::uint64_t morton, int log2_samples, int base4_digits, std::uint64_t seed)
-        : morton_(morton), log2_samples_(log2_samples), base4_digits_(base4_digits),
-          single_base_(sampling::hash_key(0, seed, 1)), pair_base_(sampling::hash_key(0, seed, 2)),
-          salt_base_(sampling::hash_key(0, seed, 3)) {}
+    constexpr ZSobolSampler(std::uint64_t morton, int log2_samples, int base4_digits, const sampling::ZSobolKeys& keys)
+        : morton_(morton), log2_samples_(log2_samples), base4_digits_(base4_digits), keys_(keys) {}
 
     constexpr void start_sample(int index) {
         index_ = (morton_ << log2_samples_) | std::uint64_t(std::uint32_t(index));
@@ -127,7 +132,7 @@ public:
 
     template <Scalar Real>
     constexpr Real uniform() {
-        const std::uint64_t key = sampling::dimension_key(single_base_, dimension_);
+        const std::uint64_t key = sampling::dimension_key(keys_.single, dimension_);
         // Dimension 0 of the index is the index reversed: scrambled as it is.
         const std::uint32_t bits = sampling::owen_scramble_reversed(point_index(), std::uint32_t(key));
         ++dimension_;
@@ -136,7 +141,7 @@ public:
 
     template <Scalar Real>
     constexpr Vec2<Real> uniform2() {
-        const std::uint64_t key = sampling::dimension_key(pair_base_, dimension_);
+        const std::uint64_t key = sampling::dimension_key(keys_.pair, dimension_);
         const std::uint32_t index = point_index();
         const std::uint32_t x = sampling::owen_scramble_reversed(index, std::uint32_t(key));
         const std::uint32_t y = sampling::owen_scramble_reversed(sampling::sobol_dimension1_reversed(index),
@@ -172,7 +177,7 @@ private:
     }
 
     constexpr std::uint64_t salt_of(int dimension) const {
-        return sampling::dimension_key(salt_base_, dimension);
+        return sampling::dimension_key(keys_.salt, dimension);
     }
     // The lowest base-4 digit made of the pixel's bits alone (every digit below holds sample bits).
     constexpr int first_pixel_digit() const { return (log2_samples_ + 1) / 2; }
@@ -203,9 +208,7 @@ private:
 
     std::uint64_t morton_;
     int log2_samples_, base4_digits_;
-    // The seed's hashes for single dimensions, pairs and the index shuffle's salt, which each
-    // dimension's keys start from (sampling::dimension_key).
-    std::uint64_t single_base_, pair_base_, salt_base_;
+    sampling::ZSobolKeys keys_;
     std::uint64_t index_ = 0;
     int dimension_ = 0;
     std::uint64_t known_ = 0;  // bit d: pixel_digits_[d] holds dimension d's
@@ -218,7 +221,7 @@ private:
 class ZSobolPattern {
 public:
     ZSobolPattern(int samples_per_pixel, int width, int height, std::uint64_t seed)
-        : samples_per_pixel_(std::max(1, samples_per_pixel)), seed_(seed) {
+        : samples_per_pixel_(std::max(1, samples_per_pixel)), keys_(sampling::ZSobolKeys::of(seed)) {
         log2_samples_ = std::bit_width(std::uint32_t(samples_per_pixel_ - 1));
         const int side = std::max({1, width, height});
         const int log2_side = std::bit_width(std::uint32_t(side - 1));
@@ -226,13 +229,13 @@ public:
     }
 
     ZSobolSampler for_pixel(int x, int y) const {
-        return ZSobolSampler(sampling::morton_2d(std::uint32_t(x), std::uint32_t(y)), log2_samples_, base4_digits_, seed_);
+        return ZSobolSampler(sampling::morton_2d(std::uint32_t(x), std::uint32_t(y)), log2_samples_, base4_digits_, keys_);
     }
     int samples_per_pixel() const { return samples_per_pixel_; }
 
 private:
     int samples_per_pixel_;
-    std::uint64_t seed_;
+    sampling::ZSobolKeys keys_;
     int log2_samples_ = 0, base4_digits_ = 0;
 };
 
