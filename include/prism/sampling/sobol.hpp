@@ -132,20 +132,20 @@ public:
 
     template <Scalar Real>
     constexpr Real uniform() {
-        const std::uint64_t key = sampling::dimension_key(keys_.single, dimension_);
+        const PixelDimension& known = pixel_dimension();
         // Dimension 0 of the index is the index reversed: scrambled as it is.
-        const std::uint32_t bits = sampling::owen_scramble_reversed(point_index(), std::uint32_t(key));
+        const std::uint32_t bits = sampling::owen_scramble_reversed(point_index(known), known.single_key);
         ++dimension_;
         return sampling::unit_from_bits<Real>(bits);
     }
 
     template <Scalar Real>
     constexpr Vec2<Real> uniform2() {
-        const std::uint64_t key = sampling::dimension_key(keys_.pair, dimension_);
-        const std::uint32_t index = point_index();
-        const std::uint32_t x = sampling::owen_scramble_reversed(index, std::uint32_t(key));
+        const PixelDimension& known = pixel_dimension();
+        const std::uint32_t index = point_index(known);
+        const std::uint32_t x = sampling::owen_scramble_reversed(index, std::uint32_t(known.pair_key));
         const std::uint32_t y = sampling::owen_scramble_reversed(sampling::sobol_dimension1_reversed(index),
-                                                                 std::uint32_t(key >> 32));
+                                                                 std::uint32_t(known.pair_key >> 32));
         dimension_ += 2;
         return {sampling::unit_from_bits<Real>(x), sampling::unit_from_bits<Real>(y)};
     }
@@ -158,50 +158,83 @@ public:
     constexpr void seek(int dimension) { dimension_ = dimension; }
 
 private:
+    // What a dimension's draws share across the pixel's samples: its keys (one mixing round
+    // each, dimension_key), and the shuffle of every index digit made of the pixel's bits, with
+    // the highest digit made of the sample's bits, whose permutation is chosen by the pixel's
+    // bits alone. Worked out once a pixel and dimension (for the first cached_dimensions), each
+    // sample then hashes only its lower digits: at 16 samples a pixel, one hash a draw instead of
+    // four (the keys, the salt and two digits).
+    struct PixelDimension {
+        std::uint64_t salt = 0, pair_key = 0;
+        std::uint32_t single_key = 0;
+        std::uint32_t pixel_digits = 0;  // only the low 32 bits of the index reach a point
+        std::uint8_t top = 0;            // the top sample digit's permutation, or the base-2 flip
+    };
+
     // The Sobol' index the current dimension takes for the current sample: the sample's index
     // with its base-4 digits shuffled, from the top, each by a permutation chosen by a hash of
     // the (original) digits above it, the dimension and the seed. With an odd log2 of the
     // sample count the lowest digit is base 2, flipped by a hash bit. Only the low 32 bits reach
     // a 32-bit fraction (sobol_dimension0/1), as in any 32-bit Sobol' generator.
-    // The digits of the pixel's Morton index (at and above first_pixel_digit) and the digits
-    // above them are the same for every sample of the pixel, so their shuffle is kept per
-    // dimension (pixel_digits) and each sample hashes only its own few digits: at 16 samples of
-    // a 128 x 128 image, 2 hashes a dimension instead of 9.
-    constexpr std::uint32_t point_index() {
+    constexpr std::uint32_t point_index(const PixelDimension& known) const {
         const bool odd = (log2_samples_ & 1) != 0;
-        const std::uint64_t salt = salt_of(dimension_);
-        std::uint64_t shuffled = pixel_digits(salt);
-        for (int digit = first_pixel_digit() - 1; digit >= (odd ? 1 : 0); --digit) shuffled |= shuffled_digit(digit, salt);
-        if (odd) shuffled |= (index_ & 1) ^ (mix_bits((index_ >> 1) ^ salt) >> 63);
+        const int lowest = odd ? 1 : 0;
+        int digit = first_pixel_digit() - 1;
+        std::uint64_t shuffled = known.pixel_digits;
+        if (digit >= lowest) {
+            shuffled |= permuted_digit(digit, known.top);
+            for (--digit; digit >= lowest; --digit) shuffled |= shuffled_digit(digit, known.salt);
+            if (odd) shuffled |= (index_ & 1) ^ (mix_bits((index_ >> 1) ^ known.salt) >> 63);
+        } else if (odd) {
+            shuffled |= (index_ & 1) ^ known.top;
+        }
         return std::uint32_t(shuffled);
     }
 
-    constexpr std::uint64_t salt_of(int dimension) const {
-        return sampling::dimension_key(keys_.salt, dimension);
-    }
     // The lowest base-4 digit made of the pixel's bits alone (every digit below holds sample bits).
     constexpr int first_pixel_digit() const { return (log2_samples_ + 1) / 2; }
+    constexpr int digit_shift(int digit) const { return 2 * digit - (log2_samples_ & 1); }
 
+    // Which of the 24 permutations shuffles base-4 digit `digit`: a hash of the digits above it.
+    constexpr std::uint8_t permutation_of(int digit, std::uint64_t salt) const {
+        const int shift = digit_shift(digit);
+        const std::uint64_t above = shift + 2 >= 64 ? 0 : index_ >> (shift + 2);
+        return std::uint8_t((mix_bits(above ^ salt) >> 40) % 24);
+    }
+    constexpr std::uint64_t permuted_digit(int digit, std::uint8_t permutation) const {
+        const int shift = digit_shift(digit);
+        return std::uint64_t(sampling::base4_permutation_table[permutation][(index_ >> shift) & 3]) << shift;
+    }
     // Base-4 digit `digit` of the index, shuffled, in its place.
     constexpr std::uint64_t shuffled_digit(int digit, std::uint64_t salt) const {
-        const int shift = 2 * digit - (log2_samples_ & 1);
-        const std::uint64_t above = shift + 2 >= 64 ? 0 : index_ >> (shift + 2);
-        const std::uint64_t chosen = mix_bits(above ^ salt) >> 40;
-        const auto& permutation = sampling::base4_permutation_table[std::size_t(chosen % 24)];
-        return std::uint64_t(permutation[(index_ >> shift) & 3]) << shift;
+        return permuted_digit(digit, permutation_of(digit, salt));
     }
 
-    constexpr std::uint64_t pixel_digits(std::uint64_t salt) {
-        const bool cached = dimension_ >= 0 && dimension_ < cached_dimensions;
-        const std::uint64_t bit = cached ? std::uint64_t(1) << dimension_ : 0;
-        if (cached && (known_ & bit)) return pixel_digits_[std::size_t(dimension_)];
+    constexpr PixelDimension shared_by_samples(int dimension) const {
+        PixelDimension known;
+        known.salt = sampling::dimension_key(keys_.salt, dimension);
+        known.single_key = std::uint32_t(sampling::dimension_key(keys_.single, dimension));
+        known.pair_key = sampling::dimension_key(keys_.pair, dimension);
         std::uint64_t shuffled = 0;
-        for (int digit = base4_digits_ - 1; digit >= first_pixel_digit(); --digit) shuffled |= shuffled_digit(digit, salt);
-        if (cached) {
-            pixel_digits_[std::size_t(dimension_)] = std::uint32_t(shuffled);
+        for (int digit = base4_digits_ - 1; digit >= first_pixel_digit(); --digit) shuffled |= shuffled_digit(digit, known.salt);
+        known.pixel_digits = std::uint32_t(shuffled);
+        const int top_digit = first_pixel_digit() - 1;
+        if (top_digit >= ((log2_samples_ & 1) ? 1 : 0)) known.top = permutation_of(top_digit, known.salt);
+        else if (log2_samples_ & 1) known.top = std::uint8_t(mix_bits((index_ >> 1) ^ known.salt) >> 63);
+        return known;
+    }
+
+    constexpr const PixelDimension& pixel_dimension() {
+        if (dimension_ < 0 || dimension_ >= cached_dimensions) {
+            uncached_ = shared_by_samples(dimension_);
+            return uncached_;
+        }
+        const std::uint64_t bit = std::uint64_t(1) << dimension_;
+        if (!(known_ & bit)) {
+            cache_[std::size_t(dimension_)] = shared_by_samples(dimension_);
             known_ |= bit;
         }
-        return shuffled;
+        return cache_[std::size_t(dimension_)];
     }
 
     static constexpr int cached_dimensions = 64;
@@ -211,8 +244,9 @@ private:
     sampling::ZSobolKeys keys_;
     std::uint64_t index_ = 0;
     int dimension_ = 0;
-    std::uint64_t known_ = 0;  // bit d: pixel_digits_[d] holds dimension d's
-    std::array<std::uint32_t, cached_dimensions> pixel_digits_;  // only the low 32 bits reach a point
+    std::uint64_t known_ = 0;  // bit d: cache_[d] holds dimension d's
+    std::array<PixelDimension, cached_dimensions> cache_;
+    PixelDimension uncached_;
 };
 
 // A render's ZSobol pattern: its sample count rounded up to a power of two for the index (the
