@@ -178,13 +178,12 @@ private:
     // a 32-bit fraction (sobol_dimension0/1), as in any 32-bit Sobol' generator.
     constexpr std::uint32_t point_index(const PixelDimension& known) const {
         const bool odd = (log2_samples_ & 1) != 0;
-        const int lowest = odd ? 1 : 0;
         int digit = first_pixel_digit() - 1;
         std::uint64_t shuffled = known.pixel_digits;
-        if (digit >= lowest) {
+        if (digit >= lowest_base4_digit()) {
             shuffled |= permuted_digit(digit, known.top);
-            for (--digit; digit >= lowest; --digit) shuffled |= shuffled_digit(digit, known.salt);
-            if (odd) shuffled |= (index_ & 1) ^ (mix_bits((index_ >> 1) ^ known.salt) >> 63);
+            for (--digit; digit >= lowest_base4_digit(); --digit) shuffled |= shuffled_digit(digit, known.salt);
+            if (odd) shuffled |= (index_ & 1) ^ base2_flip(known.salt);
         } else if (odd) {
             shuffled |= (index_ & 1) ^ known.top;
         }
@@ -193,7 +192,11 @@ private:
 
     // The lowest base-4 digit made of the pixel's bits alone (every digit below holds sample bits).
     constexpr int first_pixel_digit() const { return (log2_samples_ + 1) / 2; }
+    // The lowest base-4 digit: 1 where an odd log2 of the sample count leaves a base-2 digit below.
+    constexpr int lowest_base4_digit() const { return log2_samples_ & 1; }
     constexpr int digit_shift(int digit) const { return 2 * digit - (log2_samples_ & 1); }
+    // The base-2 digit's flip (odd log2 of the sample count): a hash bit of the digits above it.
+    constexpr std::uint64_t base2_flip(std::uint64_t salt) const { return mix_bits((index_ >> 1) ^ salt) >> 63; }
 
     // Which of the 24 permutations shuffles base-4 digit `digit`: a hash of the digits above it.
     constexpr std::uint8_t permutation_of(int digit, std::uint64_t salt) const {
@@ -219,8 +222,8 @@ private:
         for (int digit = base4_digits_ - 1; digit >= first_pixel_digit(); --digit) shuffled |= shuffled_digit(digit, known.salt);
         known.pixel_digits = std::uint32_t(shuffled);
         const int top_digit = first_pixel_digit() - 1;
-        if (top_digit >= ((log2_samples_ & 1) ? 1 : 0)) known.top = permutation_of(top_digit, known.salt);
-        else if (log2_samples_ & 1) known.top = std::uint8_t(mix_bits((index_ >> 1) ^ known.salt) >> 63);
+        if (top_digit >= lowest_base4_digit()) known.top = permutation_of(top_digit, known.salt);
+        else if (log2_samples_ & 1) known.top = std::uint8_t(base2_flip(known.salt));
         return known;
     }
 
