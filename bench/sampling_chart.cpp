@@ -73,7 +73,7 @@ double seconds_since(Clock::time_point start) { return std::chrono::duration<dou
 // lights only (the chart's scenes have nothing else; a scene needing more is refused by name).
 using ChartConfig = prism::Config<float, prism::PrecisionPolicy<prism::Precision::single>::Acceleration,
                                   prism::Lights<prism::LightMesh, prism::LightSphere>, prism::no_features,
-                                  prism::PathTracer>;
+                                  prism::PathTracer, prism::ChosenPattern>;
 using ChartRenderer = prism::Renderer<ChartConfig>;
 
 struct Variant {

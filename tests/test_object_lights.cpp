@@ -293,7 +293,8 @@ scene::Scene floor_under(const scene::Mesh* light_mesh, const scene::Sphere* lig
 
 TEST_CASE_TEMPLATE("ray tracer: object lights light the surfaces they face (their own surface does not shadow them)",
                    Real, float, double) {
-    using Traced = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::AllLightSet, prism::all_features>;
+    using Traced = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::AllLightSet, prism::all_features,
+                                 prism::Whitted, prism::ChosenPattern>;  // test_sampling's type
     SUBCASE("LightMesh: a unit square at y = 1, centred above the point") {
         scene::Mesh square;
         square.material = 1;

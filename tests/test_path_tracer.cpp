@@ -29,7 +29,7 @@ using prism_test::TemporaryFolder;
 // renderer type per precision for every test here (each more costs minutes of CI's builds).
 template <class Real>
 using PathConfig = prism::Config<Real, prism::WideBvh<prism::Watertight, 8>, prism::AllLightSet, prism::all_features,
-                                 prism::PathTracer>;
+                                 prism::PathTracer, prism::ChosenPattern>;
 
 // Every combination of the course's three words, and MIS (which implies next-event estimation).
 std::vector<scene::RendererParams> all_params() {

@@ -405,7 +405,8 @@ TEST_CASE_TEMPLATE("Samplers: a Config that fixes its sampler renders what the r
     camera.num_samples = 4;
     camera.image_name = "out.png";
     world.cameras.push_back(camera);
-    using Chosen = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::Lights<prism::PointLight>>;
+    using Chosen = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::Lights<prism::PointLight>, prism::Features{},
+                                 prism::Whitted, prism::ChosenPattern>;
     using Fixed = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::Lights<prism::PointLight>, prism::Features{},
                                 prism::Whitted, prism::ZSobolPattern>;
     const prism::RendererSettings sobol{prism::BackfaceCulling::triangles, prism::RayOffset::scene_epsilon, 5,

@@ -255,7 +255,10 @@ TEST_CASE_TEMPLATE("Renderer: multisampled, lens, area-lit, glossy and moving im
     ball.motion = {0.5, 0, 0};
     world.spheres.push_back(ball);
     world.area_lights.push_back({"panel", {-1, 4, -1}, {2, 0, 0}, {0, 0, 2}, {20, 20, 20}});
-    using Complete = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::AllLightSet, prism::all_features>;
+    // The run-time sampler choice (ChosenPattern), as the shipped renderers take it: one type for
+    // every sampler kind below, and the same type test_object_lights renders (one unity group).
+    using Complete = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::AllLightSet, prism::all_features,
+                                   prism::Whitted, prism::ChosenPattern>;
     const prism::Renderer<Complete> renderer(world);
     const auto render_with_threads = [&](std::size_t threads) {
         tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, threads);
@@ -473,7 +476,10 @@ TEST_CASE_TEMPLATE("Renderer: a pixel's samples lit side by side (radiances_at) 
     world.ambient_light = glm::dvec3(0.05);
     world.max_recursion_depth = 4;
     const scene::Mesh tent = ridged_tent(4);  // behind the balls: the scene keeps its index
-    using Complete = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::AllLightSet, prism::all_features>;
+    // The run-time sampler choice (ChosenPattern), as the shipped renderers take it: one type for
+    // every sampler kind below, and the same type test_object_lights renders (one unity group).
+    using Complete = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::AllLightSet, prism::all_features,
+                                   prism::Whitted, prism::ChosenPattern>;
     using Whole = prism::Renderer<Complete>;
     for (const bool indexed : {false, true}) {
         CAPTURE(indexed);

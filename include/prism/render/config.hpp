@@ -1,9 +1,10 @@
 // A renderer's compile-time configuration: scalar type, acceleration policy (index and triangle
 // intersector), light types, the shading features that cost work on every ray, and the
-// integrator, and the sampler (sampling/sampler_choice.hpp: one fixed pattern, or ChosenPattern,
-// chosen at run time). `Renderer<Config<float, Bvh<Watertight>, Lights<PointLight>>>` is a type that
-// contains exactly the code those choices need: without `Features::textures` no hit looks up a
-// texture, without `Features::motion_blur` no ray is moved in time. `covers(needs)` states
+// integrator, and the sampler (sampling/sampler_choice.hpp: one fixed pattern, DefaultPattern
+// unless named, or ChosenPattern, chosen at run time as the shipped renderers take it).
+// `Renderer<Config<float, Bvh<Watertight>, Lights<PointLight>>>` is a type that contains exactly
+// the code those choices need: without `Features::textures` no hit looks up a texture, without
+// `Features::motion_blur` no ray is moved in time. `covers(needs)` states
 // which scenes a Config can render (scene/needs.hpp), so a dispatcher picks among shipped
 // Configs without knowing their parts.
 #pragma once
@@ -27,7 +28,7 @@ struct Features {
 };
 
 template <Scalar RealT, class AccelerationT = Bvh<Watertight>, class LightTypesT = Lights<PointLight>,
-          Features FeaturesV = Features{}, class IntegratorT = Whitted, class SamplerT = ChosenPattern>
+          Features FeaturesV = Features{}, class IntegratorT = Whitted, class SamplerT = DefaultPattern>
     requires AccelerationPolicy<AccelerationT, RealT> && IntegratorPolicy<IntegratorT> && SamplerPattern<SamplerT, RealT>
 struct Config {
     using Real = RealT;

@@ -163,9 +163,9 @@ template <class... Configs> struct ConfigList {};
 // not one per light set (DESIGN.md), and a scene without a path-traced camera never runs it.
 template <Precision P, class Real = typename PrecisionPolicy<P>::Real,
           class Acceleration = typename PrecisionPolicy<P>::Acceleration>
-using ShippedConfigs = ConfigList<Config<Real, Acceleration, PointLightSet, no_features, Whitted>,
-                                  Config<Real, Acceleration, AllLightSet, all_features, Whitted>,
-                                  Config<Real, Acceleration, AllLightSet, all_features, PathTracer>>;
+using ShippedConfigs = ConfigList<Config<Real, Acceleration, PointLightSet, no_features, Whitted, ChosenPattern>,
+                                  Config<Real, Acceleration, AllLightSet, all_features, Whitted, ChosenPattern>,
+                                  Config<Real, Acceleration, AllLightSet, all_features, PathTracer, ChosenPattern>>;
 #ifdef PRISM_WITH_EMBREE
 // The same through Embree (--accelerator embree), which traverses in float.
 using EmbreeShippedConfigs = ShippedConfigs<Precision::single, float, Embree>;
