@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# One scene rendered by several `prism` binaries, paired: every round runs each binary once, the
+# order rotated from round to round, so that a shared machine's load and drift fall on all of
+# them alike. Each binary's time is taken over the first binary's of the same round; the medians
+# and ranges of those ratios are what bench/RESULTS.md records ("Whole renders", "Path tracer").
+# Every render's images are compared, byte for byte, with the first binary's of its round: a
+# binary that wrote other pixels is reported, since a ratio between different images means little.
+#
+#   bash bench/paired.sh ROUNDS SCENE LABEL=PRISM [LABEL=PRISM]... [-- PRISM_OPTIONS...]
+#
+#   bash bench/paired.sh 9 ../shared/ceng795/hw4/2017S_goksuguvendiren/inputs/5/glass_plates_point.xml \
+#       fb59e22=FB59E22/build/examples/prism main=build/examples/prism -- --threads 2 --scale 0.5
+#
+# Prints per binary: the median user and wall times (s), then user and wall time over the first
+# binary's, as median (min-max) of the rounds, and "same images" or how many rounds differed.
+set -euo pipefail
+
+if [[ $# -lt 3 ]]; then
+  sed -n '2,15p' "$0" >&2
+  exit 2
+fi
+rounds=$1 scene=$2
+shift 2
+labels=() binaries=()
+while [[ $# -gt 0 && $1 != -- ]]; do
+  [[ $1 == *=* ]] || { echo "paired.sh: expected LABEL=PRISM, got $1" >&2; exit 2; }
+  labels+=("${1%%=*}") binaries+=("${1#*=}")
+  shift
+done
+[[ $# -gt 0 ]] && shift
+options=("$@")
+for binary in "${binaries[@]}"; do
+  [[ -x $binary ]] || { echo "paired.sh: $binary is not an executable" >&2; exit 2; }
+done
+[[ -f $scene ]] || { echo "paired.sh: no scene file $scene" >&2; exit 2; }
+
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+count=${#binaries[@]}
+for ((round = 0; round < rounds; ++round)); do
+  for ((j = 0; j < count; ++j)); do
+    k=$(((j + round) % count))
+    out=$work/out_$k
+    rm -rf "$out"
+    if ! /usr/bin/time -o "$work/time" -f '%e %U' "${binaries[$k]}" "$scene" "${options[@]}" --output-dir "$out" \
+      > "$work/log" 2>&1; then
+      echo "paired.sh: ${labels[$k]} failed on $scene:" >&2
+      tail -5 "$work/log" >&2
+      exit 1
+    fi
+    read -r wall user < "$work/time"
+    echo "$round $k $wall $user" >> "$work/times"
+  done
+  for ((k = 1; k < count; ++k)); do
+    same=1
+    for image in "$work/out_0"/*; do
+      cmp -s "$image" "$work/out_$k/$(basename "$image")" || same=0
+    done
+    [[ $(ls "$work/out_0" | wc -l) == $(ls "$work/out_$k" | wc -l) ]] || same=0
+    echo "$round $k $same" >> "$work/same"
+  done
+done
+touch "$work/same"
+python3 - "$work/times" "$work/same" "${labels[@]}" <<'EOF'
+import statistics, sys
+times, same, labels = sys.argv[1], sys.argv[2], sys.argv[3:]
+wall, user = {}, {}
+for line in open(times):
+    r, k, w, u = line.split()
+    wall[(int(r), int(k))] = float(w)
+    user[(int(r), int(k))] = float(u)
+differing = {}
+for line in open(same):
+    r, k, s = line.split()
+    if s == "0":
+        differing[int(k)] = differing.get(int(k), 0) + 1
+rounds = sorted({r for r, _ in wall})
+def spread(values):
+    if not values:
+        return "n/a (times under the timer's 10 ms)"
+    return f"{statistics.median(values):.3f} ({min(values):.3f}-{max(values):.3f})"
+for k, label in enumerate(labels):
+    u = [user[(r, k)] for r in rounds]
+    w = [wall[(r, k)] for r in rounds]
+    line = f"{label:>14}  user {statistics.median(u):7.2f} s  wall {statistics.median(w):7.2f} s"
+    if k > 0:
+        line += f"  /{labels[0]}: user {spread([user[(r, k)] / user[(r, 0)] for r in rounds if user[(r, 0)] > 0])}"
+        line += f", wall {spread([wall[(r, k)] / wall[(r, 0)] for r in rounds if wall[(r, 0)] > 0])}"
+        line += "  same images" if k not in differing else f"  OTHER IMAGES in {differing[k]} of {len(rounds)} rounds"
+    print(line)
+EOF
