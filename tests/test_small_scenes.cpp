@@ -488,7 +488,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: a world-space index whose root has two leaves
         return p;
     };
     const prism::BackfaceCulling cullings[] = {prism::BackfaceCulling::none, prism::BackfaceCulling::triangles};
-    std::size_t rays = 0, hits = 0, wall_hits = 0, blocked = 0, edge_rays = 0;
+    std::size_t rays = 0, hits = 0, wall_hits = 0, blocked = 0, edge_rays = 0, lefts = 0;
     for (int i = 0; i < 100000; ++i) {
         glm::dvec3 origin, direction;
         switch (i % 4) {
@@ -521,6 +521,16 @@ TEST_CASE_TEMPLATE("SceneGeometry: a world-space index whose root has two leaves
         }
         prism::Ray<Real> ray{Vec3(origin), Vec3(direction), Real(i % 4 == 3 ? 1e-3 : 0), Real(60)};
         if (i % 3 == 0) ray.t_max = Real(30 * std::abs(uniform(random)));
+        if (i % 16 == 5) ray.direction[std::size_t(i / 16) % 3] = Real(i % 32 == 5 ? 0 : -0.0);  // along a face
+        // The leaves' boxes in one pass (left_by) say what leaves_box says of each; of a ray
+        // that starts behind its origin (t_min < 0), nothing.
+        prism::Ray<Real> probe = ray;
+        if (i % 64 == 7) probe.t_min = Real(-1);
+        std::uint32_t left = 0;
+        for (int leaf = 0; leaf < leaves->count; ++leaf)
+            left |= std::uint32_t(prism::leaves_box(leaves->leaf[std::size_t(leaf)].box, probe)) << leaf;
+        CHECK(leaves->left_by(probe) == left);
+        lefts += left != 0;
         for (const prism::BackfaceCulling culling : cullings) {
             CAPTURE(i);
             CAPTURE(int(culling));
@@ -546,6 +556,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: a world-space index whose root has two leaves
         }
     }
     CHECK(edge_rays > 40000);
+    CHECK(lefts > 10000);  // the boxes' test skipped leaves for many rays
     CHECK(hits > rays / 2);
     CHECK(wall_hits > rays / 3);
     CHECK(blocked > rays / 3);

@@ -543,9 +543,10 @@ private:
         Real nearest = ray.t_max;
         Hit<Real> nearest_hit;
         bool found = false, tied = false;
+        const std::uint32_t left = leaves.left_by(ray);
         for (int i = 0; i < leaves.count; ++i) {
             const auto& leaf = leaves.leaf[std::size_t(i)];
-            if (leaves_box(leaf.box, ray)) continue;
+            if ((left >> i) & 1) continue;
             if (!triangle_ray) triangle_ray.emplace(ray);
             Real t = ray.t_max;
             Hit<Real> candidate = hit;
@@ -579,9 +580,10 @@ private:
             std::optional<TriangleRay> triangle_ray;
             for (const WorldMeshes& group : world_meshes_) {
                 const Mesh& index = index_of(group);
+                const std::uint32_t left = Several ? group.leaves->left_by(ray) : std::uint32_t(leaves_box(group.leaves->leaf[0].box, ray));
                 for (int i = 0; i < (Several ? group.leaves->count : 1); ++i) {
                     const auto& leaf = group.leaves->leaf[std::size_t(i)];
-                    if (leaves_box(leaf.box, ray)) continue;
+                    if ((left >> i) & 1) continue;
                     if (!triangle_ray) triangle_ray.emplace(ray);
                     if (index.occluded_leaf(ray, *triangle_ray, leaf, ray.t_max)) return true;
                 }

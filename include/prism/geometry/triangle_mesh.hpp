@@ -116,6 +116,26 @@ public:
     struct RootLeaves {
         std::array<Leaf, max_root_leaves> leaf{};
         int count = 0;
+        // The leaves' boxes by axis, a leaf in each lane (lanes past count: empty boxes at 0).
+        alignas(4 * sizeof(Real)) Real lower[3][max_root_leaves]{};
+        alignas(4 * sizeof(Real)) Real upper[3][max_root_leaves]{};
+
+        // Bit i set where the ray leaves leaf i's box as leaves_box says (the same comparisons,
+        // every leaf in one pass): a wall's rays that start beyond it and do not come back, which
+        // its leaf's test then skips. The hw7 Cornell boxes' three leaves took a third of their
+        // rays' traversal instructions box by box (valgrind's count, path_diffuse).
+        PRISM_FORCE_INLINE std::uint32_t left_by(const Ray<Real>& ray) const {
+            using Lanes = simd::Pack<Real, max_root_leaves>;
+            const Lanes zero = Lanes::broadcast(Real(0));
+            simd::Mask<Real, max_root_leaves> away = zero < zero;
+            for (int axis = 0; axis < 3; ++axis) {
+                const Lanes origin = Lanes::broadcast(ray.origin[axis]);
+                const Lanes direction = Lanes::broadcast(ray.direction[axis]);
+                away = away | ((origin > Lanes::load(upper[axis])) & (direction >= zero)) |
+                       ((origin < Lanes::load(lower[axis])) & (direction <= zero));
+            }
+            return ray.t_min >= 0 ? away.bits() & ((1u << count) - 1) : 0u;
+        }
     };
     std::optional<RootLeaves> root_leaves() const {
         if constexpr (packed && requires { Index::width; }) {
@@ -131,6 +151,8 @@ public:
                 for (int axis = 0; axis < 3; ++axis) {
                     leaf.box.min[axis] = nodes[0].bounds[axis][i];
                     leaf.box.max[axis] = nodes[0].bounds[3 + axis][i];
+                    leaves.lower[axis][leaves.count - 1] = leaf.box.min[axis];
+                    leaves.upper[axis][leaves.count - 1] = leaf.box.max[axis];
                 }
             }
             if (leaves.count > 0) return leaves;
