@@ -148,7 +148,6 @@ Pattern make_pattern(const SamplingLayout& layout) {
     }
 }
 
-// A Config's sampler where it names none: default_sampler's own pattern, fixed at compile time.
 // Without the other two samplers and the switch per draw, examples/minimal compiles in 0.3-0.6 s
 // less of its 12 s (bench/RESULTS.md, "Compile cost").
 using DefaultPattern = IndependentPattern;
