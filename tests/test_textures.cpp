@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #ifndef PRISM_SHARED_DIR
@@ -168,6 +169,14 @@ TEST_CASE_TEMPLATE("MipMap: the level of detail of a ray cone", Real, float, dou
 
 namespace {
 
+// TextureSet::apply's unshaded colour as an optional, as the decal mode cases below check it.
+template <Scalar Real>
+std::optional<Vec3<Real>> applied(const TextureSet<Real>& set, SurfacePoint<Real>& point, Material<Real>& material) {
+    Vec3<Real> unshaded(-1);
+    if (set.apply(point, material, unshaded)) return unshaded;
+    return std::nullopt;
+}
+
 // Perlin 2002 in its original form (fade-weighted lerps of the eight corner dot products), an
 // independent check of the course's weight-product form the library uses.
 double reference_noise(double x, double y, double z) {
@@ -281,27 +290,27 @@ TEST_CASE_TEMPLATE("TextureSet: replace_kd, blend_kd, replace_ks, replace_all wi
     {
         Material<Real> material(grey_material());
         SurfacePoint<Real> point = flat_point<Real>(replace);
-        CHECK(!set.apply(point, material));
+        CHECK(!applied(set, point, material));
         check_vec(material.diffuse, value);
         check_vec(material.specular, Vec3<Real>(Real(0.5)));
     }
     {
         Material<Real> material(grey_material());
         SurfacePoint<Real> point = flat_point<Real>(blend);
-        set.apply(point, material);
+        applied(set, point, material);
         check_vec(material.diffuse, (Vec3<Real>(Real(0.4)) + value) / Real(2));
     }
     {
         Material<Real> material(grey_material());
         SurfacePoint<Real> point = flat_point<Real>(specular);
-        set.apply(point, material);
+        applied(set, point, material);
         check_vec(material.specular, value);
         check_vec(material.diffuse, Vec3<Real>(Real(0.4)));
     }
     {
         Material<Real> material(grey_material());
         SurfacePoint<Real> point = flat_point<Real>(all);
-        const auto unshaded = set.apply(point, material);
+        const auto unshaded = applied(set, point, material);
         REQUIRE(unshaded);
         check_vec(*unshaded, Vec3<Real>(51, 102, 204));  // Normalizer 1: the stored texel
         check_vec(material.diffuse, Vec3<Real>(Real(0.4)));
@@ -310,13 +319,13 @@ TEST_CASE_TEMPLATE("TextureSet: replace_kd, blend_kd, replace_ks, replace_all wi
         // In the file's order: replace, then blend with the replaced value.
         Material<Real> material(grey_material());
         SurfacePoint<Real> point = flat_point<Real>(replace_then_blend);
-        set.apply(point, material);
+        applied(set, point, material);
         check_vec(material.diffuse, value);
     }
     {
         Material<Real> material(grey_material());
         SurfacePoint<Real> point = flat_point<Real>({});
-        CHECK(!set.apply(point, material));
+        CHECK(!applied(set, point, material));
         check_vec(material.diffuse, Vec3<Real>(Real(0.4)));
         CHECK(TextureSet<Real>(scene::Scene{}).empty());
     }
@@ -332,10 +341,10 @@ TEST_CASE_TEMPLATE("TextureSet: degamma after normalising; HDR texels are neithe
     const std::vector<std::uint32_t> ldr{0}, hdr{1};
     Material<Real> material(grey_material());
     SurfacePoint<Real> point = flat_point<Real>(ldr);
-    set.apply(point, material);
+    applied(set, point, material);
     check_vec(material.diffuse, Vec3<Real>(Real(std::pow(0.2, 2.2))));
     point = flat_point<Real>(hdr);
-    set.apply(point, material);
+    applied(set, point, material);
     check_vec(material.diffuse, Vec3<Real>(3));
 }
 
@@ -351,7 +360,7 @@ TEST_CASE_TEMPLATE("TextureSet: replace_normal rotates the normal into the (dpdu
     Material<Real> material(grey_material());
 
     SurfacePoint<Real> point = flat_point<Real>(textures, {Real(0.25), Real(0.5)});
-    set.apply(point, material);
+    applied(set, point, material);
     check_vec(point.shading_normal, Vec3<Real>(Real(0.6), 0, Real(0.8)));  // red: along dpdu
     CHECK(point.geometric_normal == Vec3<Real>(0, 0, 1));
 
@@ -359,19 +368,19 @@ TEST_CASE_TEMPLATE("TextureSet: replace_normal rotates the normal into the (dpdu
     // course's image at 32.1 dB this way, 26.8 dB with green flipped.
     point = flat_point<Real>(textures, {Real(0.75), Real(0.5)});
     point.dpdv = {0, -3, 0};
-    set.apply(point, material);
+    applied(set, point, material);
     check_vec(point.shading_normal, Vec3<Real>(0, Real(-0.6), Real(0.8)));
 
     // A frame on a tilted surface: T = dpdu made orthogonal to N.
     point = flat_point<Real>(textures, {Real(0.25), Real(0.5)});
     point.dpdu = {2, 0, 5};  // has a part along N, dropped
-    set.apply(point, material);
+    applied(set, point, material);
     check_vec(point.shading_normal, Vec3<Real>(Real(0.6), 0, Real(0.8)));
 
     // No (u, v): nothing to map on.
     point = flat_point<Real>(textures, {Real(0.25), Real(0.5)});
     point.dpdu = point.dpdv = Vec3<Real>(0);
-    set.apply(point, material);
+    applied(set, point, material);
     CHECK(point.shading_normal == Vec3<Real>(0, 0, 1));
 }
 
@@ -385,13 +394,13 @@ TEST_CASE_TEMPLATE("TextureSet: bump_normal: heights in the file's units, one te
     {
         const TextureSet<Real> set(scene);
         SurfacePoint<Real> point = flat_point<Real>(textures, {Real(0.375), Real(0.5)});
-        set.apply(point, material);
+        applied(set, point, material);
         check_vec(point.shading_normal, glm::normalize(Vec3<Real>(-1, 0, 1)));
         CHECK(double(glm::length(point.shading_normal)) == doctest::Approx(1.0));
         // Nearest: texel 1 (u W = 1.5) and texel 2: the same difference.
         scene.textures[0].interpolation = scene::Interpolation::nearest;
         point = flat_point<Real>(textures, {Real(0.375), Real(0.5)});
-        TextureSet<Real>(scene).apply(point, material);
+        applied(TextureSet<Real>(scene), point, material);
         check_vec(point.shading_normal, glm::normalize(Vec3<Real>(-1, 0, 1)));
         scene.textures[0].interpolation = scene::Interpolation::bilinear;
     }
@@ -399,18 +408,18 @@ TEST_CASE_TEMPLATE("TextureSet: bump_normal: heights in the file's units, one te
         scene.textures[0].bump_factor = 0.5;
         const TextureSet<Real> set(scene);
         SurfacePoint<Real> point = flat_point<Real>(textures, {Real(0.375), Real(0.5)});
-        set.apply(point, material);
+        applied(set, point, material);
         check_vec(point.shading_normal, glm::normalize(Vec3<Real>(Real(-0.5), 0, 1)));
         // A left-handed (u, v) frame (v down the image, the course's spheres): the same slope
         // in u still tilts away from +u.
         point = flat_point<Real>(textures, {Real(0.375), Real(0.5)});
         point.dpdv = {0, -1, 0};
-        set.apply(point, material);
+        applied(set, point, material);
         check_vec(point.shading_normal, glm::normalize(Vec3<Real>(Real(-0.5), 0, 1)));
         // Twice as long a tangent: half the slope per unit length.
         point = flat_point<Real>(textures, {Real(0.375), Real(0.5)});
         point.dpdu = {2, 0, 0};
-        set.apply(point, material);
+        applied(set, point, material);
         check_vec(point.shading_normal, glm::normalize(Vec3<Real>(Real(-0.25), 0, 1)));
         // A mesh scaled by 1/20: heights in its own units, so a unit of height moves the point
         // by 1/20 and the tilt is 1/20 (bump_mapping_transformed's floor). Its world tangents
@@ -419,13 +428,13 @@ TEST_CASE_TEMPLATE("TextureSet: bump_normal: heights in the file's units, one te
         point.texture_frame = Mat3<Real>(Real(0.05));
         point.dpdu = {Real(0.05), 0, 0};
         point.dpdv = {0, Real(0.05), 0};
-        set.apply(point, material);
+        applied(set, point, material);
         check_vec(point.shading_normal, glm::normalize(Vec3<Real>(Real(-0.5), 0, 1)));
         // The same tangents in world units (a sphere's): the full slope per unit length, 20 x 0.5.
         point = flat_point<Real>(textures, {Real(0.375), Real(0.5)});
         point.dpdu = {Real(0.05), 0, 0};
         point.dpdv = {0, Real(0.05), 0};
-        set.apply(point, material);
+        applied(set, point, material);
         check_vec(point.shading_normal, glm::normalize(Vec3<Real>(-10, 0, 1)));
     }
     {
@@ -433,7 +442,7 @@ TEST_CASE_TEMPLATE("TextureSet: bump_normal: heights in the file's units, one te
         scene.textures[0].bump_factor = 1;
         scene.textures[0].normalizer = 127.5;
         SurfacePoint<Real> point = flat_point<Real>(textures, {Real(0.375), Real(0.5)});
-        TextureSet<Real>(scene).apply(point, material);
+        applied(TextureSet<Real>(scene), point, material);
         check_vec(point.shading_normal, glm::normalize(Vec3<Real>(-2, 0, 1)));
     }
 }
@@ -497,7 +506,7 @@ TEST_CASE_TEMPLATE("Mesh bump: the tangent frame from a triangle's texture coord
         REQUIRE(prism::closest_hit(geometry, ray, hit));
         SurfacePoint<Real> point = geometry.surface(ray, hit);
         Material<Real> material(grey_material());
-        TextureSet<Real>(scene).apply(point, material);
+        applied(TextureSet<Real>(scene), point, material);
         return point.shading_normal;
     };
     // (u, v) = (0.375, 0.375) lies at (0.75, 0.375, 0).
@@ -535,12 +544,12 @@ TEST_CASE_TEMPLATE("TextureSet: Perlin colours and bumps in the texture space", 
     const Vec3<Real> p{Real(0.3), Real(0.45), Real(0.1)};
     point.texture_position = p;
     point.position = point.local_position = {7, 7, 7};  // ignored: textures read the texture space
-    set.apply(point, material);
+    applied(set, point, material);
     const auto height = [&](Vec3<Real> q) { return (PerlinNoise<Real>::noise(q * Real(3)) + 1) / 2; };
     check_vec(material.diffuse, Vec3<Real>(height(p)), 1e-4);
 
     point.textures = bump;
-    set.apply(point, material);
+    applied(set, point, material);
     const Vec3<Real> n = point.shading_normal;
     CHECK(double(glm::length(n)) == doctest::Approx(1.0));
     CHECK(n.z > 0);
@@ -556,7 +565,7 @@ TEST_CASE_TEMPLATE("TextureSet: Perlin colours and bumps in the texture space", 
     point = flat_point<Real>(bump);
     point.texture_position = p;
     point.texture_frame = Mat3<Real>(Vec3<Real>(0, 2, 0), Vec3<Real>(-2, 0, 0), Vec3<Real>(0, 0, 2));  // columns
-    set.apply(point, material);
+    applied(set, point, material);
     check_vec(point.shading_normal, Vec3<Real>(-n.y, n.x, n.z), 1e-4);
 }
 
@@ -580,7 +589,7 @@ TEST_CASE_TEMPLATE("TextureSet: Perlin bumps step 10^-3 in texture space, whatev
     Material<Real> material(grey_material());
     SurfacePoint<Real> point = flat_point<Real>(bump);
     point.texture_position = {0, Real(0.0005), 0};
-    set.apply(point, material);
+    applied(set, point, material);
     check_vec(point.shading_normal, glm::normalize(Vec3<Real>(Real(0.125), 0, 1)), 1e-4);
 }
 
@@ -608,7 +617,7 @@ TEST_CASE_TEMPLATE("TextureSet: the background texture at a pixel's (u, v)", Rea
     const std::vector<std::uint32_t> textures{0};
     Material<Real> material(grey_material());
     SurfacePoint<Real> point = flat_point<Real>(textures);
-    CHECK(!set.apply(point, material));
+    CHECK(!applied(set, point, material));
     check_vec(material.diffuse, Vec3<Real>(Real(0.4)));
 }
 

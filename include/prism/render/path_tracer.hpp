@@ -185,8 +185,8 @@ private:
             Material<Real> material = materials_[point.material];
             travelled += hit.t;
             const RayCone<Real> cone{travelled * path.spread, std::abs(glm::dot(ray.direction, point.shading_normal))};
-            if (const std::optional<Vec3<Real>> unshaded = textures_.apply(point, material, cone)) {
-                color += throughput * *unshaded;
+            if (Vec3<Real> unshaded; textures_.apply(point, material, unshaded, cone)) {
+                color += throughput * unshaded;
                 break;
             }
             const Vec3<Real>& d = ray.direction;
@@ -254,7 +254,8 @@ private:
                 throughput /= survival;
             }
             previous_position = point.position;
-            ray = leaving(point, normal, direction, ray.time);
+            // In one store (stored_whole): the next intersect reads the ray whole.
+            ray = stored_whole(leaving(point, normal, direction, ray.time));
         }
         return color;
     }

@@ -73,12 +73,12 @@ struct IntegratorSettings {
 // A surface's textures as the integrator uses them; `NoTextures` is the policy of renderers
 // compiled without texture support, and costs nothing.
 // The interface is TextureSet's (texture/texture_set.hpp): apply() changes the material and
-// the shading normal and may return an unshaded colour (replace_all); background() is the
+// the shading normal and may give an unshaded colour (replace_all); background() is the
 // replace_background texture at the pixel.
 template <Scalar Real>
 struct NoTextures {
     explicit NoTextures(const scene::Scene&) {}
-    std::optional<Vec3<Real>> apply(SurfacePoint<Real>&, const Material<Real>&, const RayCone<Real>&) const { return {}; }
+    bool apply(SurfacePoint<Real>&, const Material<Real>&, Vec3<Real>&, const RayCone<Real>&) const { return false; }
     std::optional<Vec3<Real>> background(const Vec2<Real>&) const { return {}; }
 };
 
@@ -276,7 +276,7 @@ private:
             materials_[point.material];
         travelled += hit.t;
         const RayCone<Real> cone{travelled * path.spread, std::abs(glm::dot(ray.direction, point.shading_normal))};
-        if (const std::optional<Vec3<Real>> unshaded = textures_.apply(point, material, cone)) return *unshaded;
+        if (Vec3<Real> unshaded; textures_.apply(point, material, unshaded, cone)) return unshaded;
         Sampler& sampler = path.sampler;
         const Vec3<Real>& d = ray.direction;
         const bool front_face = glm::dot(point.geometric_normal, d) < 0;

@@ -43,10 +43,7 @@ void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment, Sampler
         if constexpr (textured<Textures, Real>) copies.make(std::size_t(i), materials_[at.point.material]);
         at.travelled = Real(0) + hits[i].t;
         const RayCone<Real> cone{at.travelled * path.spread, std::abs(glm::dot(ray.direction, at.point.shading_normal))};
-        if (const std::optional<Vec3<Real>> unshaded = textures_.apply(at.point, material_of(i), cone)) {
-            radiance[i] = *unshaded;
-            continue;
-        }
+        if (textures_.apply(at.point, material_of(i), radiance[i], cone)) continue;
         at.front_face = glm::dot(at.point.geometric_normal, ray.direction) < 0;
         at.normal = at.front_face ? at.point.shading_normal : -at.point.shading_normal;
         at.inside_medium = !at.front_face && material_of(i).type == scene::MaterialType::dielectric;

@@ -9,8 +9,8 @@
 //   used as is (no Normalizer, no degamma).
 // - replace_all makes the value the point's colour, unshaded: ellipsoids_texture's left earth
 //   and VeachAjar's picture (Normalizer 1, texels 0..255) show the image at its stored
-//   brightness with no highlight or shadow, next to lit objects. The integrator receives it as
-//   the return value of apply().
+//   brightness with no highlight or shadow, next to lit objects. The integrator receives it
+//   from apply().
 // - Perlin and checkerboard values are taken in the texture space of SurfacePoint
 //   (geometry/hit.hpp): a mesh's object space, world space on spheres and planes. With the
 //   course's noise table (texture/perlin.hpp), cube_perlin (two transformed cube meshes) renders
@@ -117,24 +117,27 @@ public:
     bool empty() const { return textures_.empty(); }
 
     // Applies the point's textures in their order in the scene file: colours go into `material`,
-    // normal and bump maps into point.shading_normal (unit, on the side it was). Returns the
-    // unshaded colour a replace_all texture gives the point (the last one, if several); the
-    // integrator uses it as the point's radiance instead of shading.
+    // normal and bump maps into point.shading_normal (unit, on the side it was). Returns whether
+    // a replace_all texture gives the point its colour, unshaded (the last one, if several),
+    // written to `unshaded`; the integrator uses it as the point's radiance instead of shading.
     // `cone` sets the level of detail of trilinear textures (see MipMap::level_of_detail); the
     // default reads the finest level.
     // A point without textures returns at once, inlined into the integrator: out of line, the
     // call alone (its frame set up for the texture lookups) was 3.3-3.9% of hw7 path_diffuse's
-    // and path_glass's time, scenes with no texture at all.
-    PRISM_FORCE_INLINE std::optional<Vec3<Real>> apply(SurfacePoint<Real>& point, Material<Real>& material,
-                                                           const RayCone<Real>& cone = {}) const {
-        if (point.textures.empty()) return {};
-        return apply_textures(point, material, cone);
+    // and path_glass's time, scenes with no texture at all. The colour is written to an
+    // argument rather than returned as a std::optional: the optional of a point without
+    // textures was stored in part (its flag) and then read whole, a read that waits for the
+    // store to reach the cache (store forwarding fails): 15% of the path tracer's trace.
+    PRISM_FORCE_INLINE bool apply(SurfacePoint<Real>& point, Material<Real>& material, Vec3<Real>& unshaded,
+                                  const RayCone<Real>& cone = {}) const {
+        if (point.textures.empty()) return false;
+        return apply_textures(point, material, unshaded, cone);
     }
 
 private:
-    std::optional<Vec3<Real>> apply_textures(SurfacePoint<Real>& point, Material<Real>& material,
-                                             const RayCone<Real>& cone) const {
-        std::optional<Vec3<Real>> unshaded;
+    bool apply_textures(SurfacePoint<Real>& point, Material<Real>& material, Vec3<Real>& unshaded,
+                        const RayCone<Real>& cone) const {
+        bool replaced = false;
         for (const std::uint32_t index : point.textures) {
             const Entry& texture = textures_[index];
             switch (texture.decal_mode) {
@@ -143,13 +146,16 @@ private:
                     material.diffuse = (material.diffuse + value(texture, point, cone)) / Real(2);
                     break;
                 case scene::DecalMode::replace_ks: material.specular = value(texture, point, cone); break;
-                case scene::DecalMode::replace_all: unshaded = value(texture, point, cone); break;
+                case scene::DecalMode::replace_all:
+                    unshaded = value(texture, point, cone);
+                    replaced = true;
+                    break;
                 case scene::DecalMode::replace_normal: replace_normal(texture, point, cone); break;
                 case scene::DecalMode::bump_normal: bump_normal(texture, point, cone); break;
                 case scene::DecalMode::replace_background: break;  // background(), for escaping rays
             }
         }
-        return unshaded;
+        return replaced;
     }
 
 public:
