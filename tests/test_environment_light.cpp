@@ -206,6 +206,52 @@ TEST_CASE_TEMPLATE("piecewise-constant 1D: density, frequencies and the inverse 
     CHECK(zeros.pdf(Real(0.3)) == doctest::Approx(1));
 }
 
+TEST_CASE_TEMPLATE("piecewise-constant 1D: the guided search finds std::upper_bound's cell for every u", Real, float,
+                   double) {
+    // Tables with runs of zero cells and one cell far brighter than the rest (many cells under
+    // one guide, guides with no cell of their own), of sizes that are not all multiples of the
+    // four cells a guide covers.
+    for (const std::size_t n : {std::size_t(1), std::size_t(5), std::size_t(64), std::size_t(1023)}) {
+        CAPTURE(n);
+        prism::Random random(n);
+        std::vector<Real> table(n);
+        for (std::size_t i = 0; i < n; ++i) table[i] = (i % 7 == 3 || i % 11 < 4) ? Real(0) : random.uniform<Real>();
+        table[n / 2] = n > 1 ? Real(1e4) : Real(1);
+        const prism::PiecewiseConstant1D<Real> distribution(table);
+
+        // The CDF as the constructor builds it, searched the plain way.
+        std::vector<double> running(n + 1, 0.0);
+        for (std::size_t i = 0; i < n; ++i) running[i + 1] = running[i] + double(table[i]) / double(n);
+        std::vector<Real> cdf(n + 1);
+        for (std::size_t i = 0; i <= n; ++i) cdf[i] = Real(running[i] / running[n]);
+        cdf[n] = 1;
+        const auto plain_cell = [&](Real u) {
+            const std::ptrdiff_t above = std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin();
+            return std::min(std::size_t(std::max<std::ptrdiff_t>(above - 1, 0)), n - 1);
+        };
+
+        // Every CDF value and its neighbours (the edges of the cells and of the guides' ranges),
+        // the guides' own starts and random u.
+        std::vector<Real> us = {Real(0), std::nextafter(Real(1), Real(0))};
+        for (const Real c : cdf) {
+            us.push_back(c);
+            us.push_back(std::nextafter(c, Real(0)));
+            us.push_back(std::nextafter(c, Real(1)));
+        }
+        const std::size_t guides = (n + 3) / 4;
+        for (std::size_t b = 0; b <= guides; ++b) us.push_back(Real(b) / Real(guides));
+        for (int i = 0; i < 20000; ++i) us.push_back(random.uniform<Real>());
+        int differ = 0;
+        for (const Real u : us) {
+            if (!(u >= 0 && u < 1)) continue;
+            const std::size_t cell = distribution.sample(u).cell;
+            if (cell != plain_cell(u)) ++differ;
+            if (table[cell] == 0) ++differ;  // a zero cell is never drawn
+        }
+        CHECK(differ == 0);
+    }
+}
+
 TEST_CASE_TEMPLATE("piecewise-constant 2D: density, frequencies and the inverse CDF", Real, float, double) {
     const std::size_t width = 4, height = 3;
     const std::vector<Real> table = {1, 2, 0, 1,  //

@@ -11,6 +11,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -47,6 +48,17 @@ public:
         const double total = running[n];
         for (std::size_t i = 0; i <= n; ++i) cdf_[i] = Real(running[i] / total);
         cdf_[n] = 1;
+        // One guide entry per four cells: where the search for the start of each range of u
+        // ends (Chen and Asau's guide table), so that a sample searches the few entries between
+        // two guides instead of the whole table.
+        const std::size_t buckets = (n + 3) / 4;
+        guide_.resize(buckets + 1);
+        std::size_t above = 0;
+        for (std::size_t b = 0; b <= buckets; ++b) {
+            const Real start = Real(b) / Real(buckets);
+            while (above <= n && !(start < cdf_[above])) ++above;
+            guide_[b] = std::uint32_t(above);
+        }
     }
 
     std::size_t size() const { return function_.size(); }
@@ -59,8 +71,8 @@ public:
     // never returned.
     Sample sample(Real u) const {
         const std::size_t n = size();
-        const auto above = std::upper_bound(cdf_.begin(), cdf_.end(), u);
-        const std::size_t cell = std::min<std::size_t>(std::size_t(std::max<std::ptrdiff_t>(above - cdf_.begin() - 1, 0)), n - 1);
+        const std::size_t above = upper_bound(u);
+        const std::size_t cell = std::min<std::size_t>(above > 0 ? above - 1 : 0, n - 1);
         const Real width = cdf_[cell + 1] - cdf_[cell];
         const Real offset = width > 0 ? std::clamp((u - cdf_[cell]) / width, Real(0), Real(1)) : Real(0);
         const Real x = std::min((Real(cell) + offset) / Real(n), below_one);
@@ -79,6 +91,21 @@ public:
 private:
     static constexpr Real below_one = Real(1) - std::numeric_limits<Real>::epsilon() / 2;
 
+    // std::upper_bound(cdf_, u): the first entry above u (cdf_.size() if none), searched
+    // between the guides of u's range. The guides bound the answer for every u of their range;
+    // the two steps after the search put right a u that rounding put in the neighbouring range,
+    // so the answer is std::upper_bound's for every u, NaN included (the end).
+    std::size_t upper_bound(Real u) const {
+        const std::size_t buckets = guide_.size() - 1;
+        const Real scaled = u * Real(buckets);
+        const std::size_t b = scaled > 0 ? std::min(std::size_t(scaled), buckets - 1) : 0;
+        std::size_t above =
+            std::size_t(std::upper_bound(cdf_.begin() + guide_[b], cdf_.begin() + guide_[b + 1], u) - cdf_.begin());
+        while (above > 0 && u < cdf_[above - 1]) --above;
+        while (above < cdf_.size() && !(u < cdf_[above])) ++above;
+        return above;
+    }
+
     std::size_t cell_of(Real x) const {
         const Real scaled = std::clamp(x, Real(0), Real(1)) * Real(size());
         return std::min(std::size_t(scaled), size() - 1);
@@ -91,6 +118,7 @@ private:
 
     std::vector<Real> function_;
     std::vector<Real> cdf_;
+    std::vector<std::uint32_t> guide_;  // guide_[b]: upper_bound of b / (guide_.size() - 1)
     double integral_ = 0;
 };
 
