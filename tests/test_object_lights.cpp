@@ -1,19 +1,27 @@
-// Object lights (LightMesh, LightSphere): their densities against area and solid angle, their
-// estimates against known irradiance, the loader in XML and JSON, the renderer's view of their
+// Object lights (LightMesh, LightSphere): their densities against area and solid angle (and the
+// spherical triangles LightMesh samples), their estimates against known irradiance, the
+// triangle a hit on an emitting mesh names, the loader in XML and JSON, the renderer's view of their
 // radiance, and the refusal of a renderer prism does not implement.
+#include "chi_square.hpp"
 #include "temporary_folder.hpp"
 
+#include <prism/accel/accelerator.hpp>
+#include <prism/geometry/scene_geometry.hpp>
 #include <prism/io/load.hpp>
 #include <prism/light/area_light.hpp>
 #include <prism/light/light_mesh.hpp>
 #include <prism/light/light_sphere.hpp>
 #include <prism/render/render_scene.hpp>
 #include <prism/sampling/random.hpp>
+#include <prism/sampling/spherical_triangle.hpp>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -24,33 +32,266 @@ constexpr double pi = 3.14159265358979323846;
 
 }  // namespace
 
-TEST_CASE_TEMPLATE("LightMesh: triangles chosen by area, solid-angle density |x - q|^2 / (A |cos|)", Real, float,
-                   double) {
+// The barycentric coordinates (b1, b2) of where the ray from `from` along `direction` meets the
+// plane of the triangle v0, v0 + e1, v0 + e2, and its distance; in double.
+struct PlanePoint {
+    double b1 = 0, b2 = 0, t = 0;
+};
+PlanePoint on_triangle_plane(const glm::dvec3& from, const glm::dvec3& direction, const glm::dvec3& v0,
+                             const glm::dvec3& e1, const glm::dvec3& e2) {
+    const glm::dvec3 normal = glm::cross(e1, e2);
+    const double t = glm::dot(v0 - from, normal) / glm::dot(direction, normal);
+    const glm::dvec3 q = from + t * direction - v0;
+    const double d11 = glm::dot(e1, e1), d12 = glm::dot(e1, e2), d22 = glm::dot(e2, e2);
+    const double q1 = glm::dot(q, e1), q2 = glm::dot(q, e2), determinant = d11 * d22 - d12 * d12;
+    return {(d22 * q1 - d12 * q2) / determinant, (d11 * q2 - d12 * q1) / determinant, t};
+}
+
+TEST_CASE_TEMPLATE("SphericalTriangle: its solid angle, and directions uniform in it, every one on the triangle",
+                   Real, float, double) {
+    using prism::SphericalTriangle;
+    // An octant seen from its corner subtends pi / 2; the four midpoint triangles of any
+    // triangle add up to it.
+    const SphericalTriangle octant(prism::Vec3<Real>(0), prism::Vec3<Real>(1, 0, 0), prism::Vec3<Real>(-1, 1, 0),
+                                   prism::Vec3<Real>(-1, 0, 1));
+    CHECK(octant.solid_angle() == doctest::Approx(pi / 2).epsilon(1e-6));
+    struct View {
+        glm::dvec3 from, v0, e1, e2;
+    };
+    // Far (1e-3 sr), at a middle distance, close above an edge and beside the plane, nearly in it
+    // (the viewpoint a hundredth of the edge off the plane, beside the triangle).
+    const View views[] = {{{0.2, -40, 0.1}, {0, 0, 0}, {1, 0, 0.2}, {0.1, 0.3, 1}},
+                          {{0.2, -1, 0.1}, {0, 0, 0}, {1, 0, 0.2}, {0.1, 0.3, 1}},
+                          {{0.5, 0.02, -0.01}, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}},
+                          {{-0.3, 0.01, 0.3}, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}}};
+    for (const View& view : views) {
+        CAPTURE(view.from.y);
+        const SphericalTriangle whole(prism::Vec3<Real>(view.from), prism::Vec3<Real>(view.v0),
+                                      prism::Vec3<Real>(view.e1), prism::Vec3<Real>(view.e2));
+        REQUIRE(whole.samplable());
+        // The triangle cut into m x m cells in its barycentric coordinates: cell (i, j) upright
+        // (its corner at b = (i, j) / m) and, where it fits, the cell turned over beside it.
+        const int m = 8;
+        std::vector<double> solid_angles;
+        std::vector<int> hits;
+        std::vector<int> cell_of(2 * m * m, -1);
+        for (int i = 0; i < m; ++i)
+            for (int j = 0; i + j < m; ++j)
+                for (int turned = 0; turned < 2 && i + j + turned < m; ++turned) {
+                    const auto at = [&](double b1, double b2) { return view.v0 + (b1 / m) * view.e1 + (b2 / m) * view.e2; };
+                    const glm::dvec3 p0 = turned ? at(i + 1, j + 1) : at(i, j);
+                    const glm::dvec3 p1 = turned ? at(i, j + 1) : at(i + 1, j);
+                    const glm::dvec3 p2 = turned ? at(i + 1, j) : at(i, j + 1);
+                    cell_of[2 * (i * m + j) + turned] = int(solid_angles.size());
+                    solid_angles.push_back(SphericalTriangle(view.from, p0, p1 - p0, p2 - p0).solid_angle());
+                }
+        double sum = 0;
+        for (const double omega : solid_angles) sum += omega;
+        CHECK(sum == doctest::Approx(whole.solid_angle()).epsilon(1e-6));
+        hits.assign(solid_angles.size(), 0);
+        prism::Random random(5);
+        const int count = 100000;
+        int off_triangle = 0;
+        for (int k = 0; k < count; ++k) {
+            const glm::dvec3 direction(whole.sample(random.uniform2<Real>()));
+            CHECK(glm::length(direction) == doctest::Approx(1.0).epsilon(1e-5));
+            const PlanePoint point = on_triangle_plane(view.from, direction, view.v0, view.e1, view.e2);
+            const double slack = 1e-5;
+            if (!(point.t > 0) || point.b1 < -slack || point.b2 < -slack || point.b1 + point.b2 > 1 + slack) {
+                ++off_triangle;
+                continue;
+            }
+            const int i = std::clamp(int(point.b1 * m), 0, m - 1), j = std::clamp(int(point.b2 * m), 0, m - 1 - i);
+            const bool turned = point.b1 * m - i + point.b2 * m - j > 1 && i + j + 1 < m;
+            ++hits[std::size_t(cell_of[2 * (i * m + j) + (turned ? 1 : 0)])];
+        }
+        CHECK(off_triangle == 0);
+        // 64 cells, 63 degrees of freedom: directions follow the solid angle cell by cell.
+        const double chi_square = prism_test::pearson_chi_square(solid_angles, hits, count - off_triangle);
+        CHECK(chi_square < prism_test::chi_square_quantile_999(int(solid_angles.size()) - 1));
+    }
+}
+
+// How large a triangle looks from `from` (LightMesh's weight, written out again in double):
+// A |cos| / d^3 at its centroid, at most 2 pi.
+double looks(const glm::dvec3& from, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+    const glm::dvec3 cross = glm::cross(b - a, c - a), to_centroid = (a + b + c) / 3.0 - from;
+    const double distance = glm::length(to_centroid);
+    return std::min(2 * pi, glm::length(cross) / 2 * std::abs(glm::dot(glm::normalize(cross), to_centroid)) /
+                                (distance * distance * distance));
+}
+
+TEST_CASE_TEMPLATE("LightMesh: a triangle chosen by how large it looks, then a direction uniform in its solid angle",
+                   Real, float, double) {
     scene::Mesh mesh;
-    // Two triangles of areas 0.5 and 1.5 (the second three times the first), in the plane y = 2.
+    // Two triangles of areas 0.5 and 1.5 in the plane y = 2.
     mesh.positions = {{0, 2, 0}, {1, 2, 0}, {0, 2, 1}, {4, 2, 0}};
     mesh.triangles = {{0, 1, 2}, {1, 3, 2}};
     mesh.radiance = {3, 2, 1};
     const auto light = prism::LightMesh<Real>::make(mesh, glm::dmat4(1.0), 0);
     CHECK(double(light.area) == doctest::Approx(2.0));
     prism::Random random(7);
-    const prism::ShadingFrame<Real> at{prism::Vec3<Real>(0.5, 0, 0.25), prism::Vec3<Real>(0, 1, 0)};
+    const glm::dvec3 from(0.5, 0, 0.25);
+    const prism::ShadingFrame<Real> at{prism::Vec3<Real>(from), prism::Vec3<Real>(0, 1, 0)};
+    const auto& p = mesh.positions;
+    const double weight[2] = {looks(from, p[0], p[1], p[2]), looks(from, p[1], p[3], p[2])};
+    const double chance_first = weight[0] / (weight[0] + weight[1]);
+    // Each triangle's solid angle from `at`, in double from the file's vertices.
+    const double omega[2] = {prism::SphericalTriangle(from, p[0], p[1] - p[0], p[2] - p[0]).solid_angle(),
+                             prism::SphericalTriangle(from, p[1], p[3] - p[1], p[2] - p[1]).solid_angle()};
+    REQUIRE(omega[0] > 0.01);
     int in_first = 0;
     const int n = 20000;
     for (int i = 0; i < n; ++i) {
         const prism::LightSample<Real> sample = light.sample(at, random.uniform2<Real>());
         const prism::Vec3<Real> point = at.position + sample.direction * sample.distance;
         CHECK(double(point.y) == doctest::Approx(2.0).epsilon(1e-5));
-        in_first += (point.x + point.z <= 1) ? 1 : 0;
-        // The density from area to solid angle, written out again.
-        const double cos_light = std::abs(double(sample.direction.y));
-        const double expected = double(sample.distance) * double(sample.distance) / (2.0 * cos_light);
+        const bool first = point.x + point.z <= 1;
+        in_first += first ? 1 : 0;
+        // The chance of the triangle over its solid angle.
+        const double expected = first ? chance_first / omega[0] : (1 - chance_first) / omega[1];
         CHECK(double(sample.pdf) == doctest::Approx(expected).epsilon(1e-4));
-        CHECK(double(light.pdf(at.position, point, prism::Vec3<Real>(0, 1, 0))) == doctest::Approx(expected).epsilon(1e-4));
+        CHECK(double(light.pdf(at, point, prism::Vec3<Real>(0, 1, 0), first ? 0 : 1)) == doctest::Approx(expected).epsilon(1e-4));
         CHECK(double(sample.radiance.r) == doctest::Approx(3.0 / expected).epsilon(1e-4));
     }
-    // Binomial: 0.25 n = 5000 with a standard deviation of 61; 4 sigma.
-    CHECK(std::abs(in_first - n / 4) < 250);
+    // Binomial, 4 standard deviations.
+    CHECK(std::abs(in_first - n * chance_first) < 4 * std::sqrt(n * chance_first * (1 - chance_first)));
+
+    // Facing away, every triangle is below the point's horizon: no light, and no density.
+    const prism::ShadingFrame<Real> away{at.position, prism::Vec3<Real>(0, -1, 0)};
+    for (int i = 0; i < 100; ++i) CHECK(light.sample(away, random.uniform2<Real>()).radiance == prism::Vec3<Real>(0));
+    CHECK(light.pdf(away, prism::Vec3<Real>(0.2, 2, 0.2), prism::Vec3<Real>(0, 1, 0), 0) == 0);
+
+    // Seen from far away (each triangle under smallest_solid_angle), a point is sampled by area
+    // instead, with the area density |x - q|^2 / (A_t |cos|) times the triangle's chance, and
+    // pdf() says the same.
+    const glm::dvec3 far_point(0.5, -200, 0.25);
+    const prism::ShadingFrame<Real> far{prism::Vec3<Real>(far_point), prism::Vec3<Real>(0, 1, 0)};
+    const double far_weight[2] = {looks(far_point, p[0], p[1], p[2]), looks(far_point, p[1], p[3], p[2])};
+    for (int i = 0; i < 1000; ++i) {
+        const prism::LightSample<Real> sample = light.sample(far, random.uniform2<Real>());
+        const prism::Vec3<Real> point = far.position + sample.direction * sample.distance;
+        const bool first = point.x + point.z <= 1;
+        const double chance = far_weight[first ? 0 : 1] / (far_weight[0] + far_weight[1]);
+        const double cos_light = std::abs(double(sample.direction.y));
+        const double expected = chance * double(sample.distance) * double(sample.distance) / ((first ? 0.5 : 1.5) * cos_light);
+        CHECK(double(sample.pdf) == doctest::Approx(expected).epsilon(1e-3));
+        CHECK(double(light.pdf(far, point, prism::Vec3<Real>(0, 1, 0), first ? 0 : 1)) == doctest::Approx(expected).epsilon(1e-3));
+    }
+}
+
+TEST_CASE_TEMPLATE("LightMesh: a mesh of more than 16 triangles chooses them by area", Real, float, double) {
+    // 20 triangles side by side in the plane y = 2, triangle k over x in [k^2, (k + 1)^2]: areas
+    // (2k + 1) / 2, the largest 39 times the smallest.
+    scene::Mesh mesh;
+    const int count = 20;
+    for (int k = 0; k <= count; ++k) mesh.positions.push_back({double(k * k), 2, 0});
+    for (int k = 0; k < count; ++k) {
+        mesh.positions.push_back({double(k * k), 2, 1});
+        mesh.triangles.push_back({std::uint32_t(k), std::uint32_t(k + 1), std::uint32_t(count + 1 + k)});
+    }
+    mesh.radiance = {1, 1, 1};
+    REQUIRE(mesh.triangles.size() > prism::LightMesh<Real>::weighed_by_view);
+    const auto light = prism::LightMesh<Real>::make(mesh, glm::dmat4(1.0), 0);
+    std::vector<double> areas;
+    for (int k = 0; k < count; ++k) areas.push_back((2 * k + 1) / 2.0);
+    const prism::ShadingFrame<Real> at{prism::Vec3<Real>(10, 0, 0.5), prism::Vec3<Real>(0, 1, 0)};
+    prism::Random random(3);
+    std::vector<int> hits(areas.size(), 0);
+    const int n = 40000;
+    int samplable = 0;
+    for (int i = 0; i < n; ++i) {
+        const prism::LightSample<Real> sample = light.sample(at, random.uniform2<Real>());
+        const glm::dvec3 point = glm::dvec3(at.position) + glm::dvec3(sample.direction) * double(sample.distance);
+        const int k = std::clamp(int(std::sqrt(std::max(point.x, 0.0))), 0, count - 1);
+        ++hits[std::size_t(k)];
+        const glm::dvec3 a = mesh.positions[std::size_t(k)];
+        const prism::SphericalTriangle view(glm::dvec3(at.position), a, mesh.positions[std::size_t(k + 1)] - a,
+                                            mesh.positions[std::size_t(count + 1 + k)] - a);
+        const double chance = areas[std::size_t(k)] / 200.0, distance = double(sample.distance);
+        // By solid angle where the triangle is large enough, else by area (the far ones).
+        const double expected = view.samplable() ? chance / view.solid_angle()
+                                                 : chance * distance * distance /
+                                                       (areas[std::size_t(k)] * std::abs(double(sample.direction.y)));
+        CHECK(double(sample.pdf) == doctest::Approx(expected).epsilon(1e-3));
+        samplable += view.samplable() ? 1 : 0;
+    }
+    CHECK(prism_test::pearson_chi_square(areas, hits, n) < prism_test::chi_square_quantile_999(count - 1));
+    // Both ways of sampling within a triangle were taken.
+    CHECK(samplable > n / 10);
+    CHECK(samplable < n - n / 10);
+}
+
+TEST_CASE_TEMPLATE("LightMesh: beside the light its estimates stay bounded, and their mean is Lambert's irradiance",
+                   Real, float, double) {
+    // A unit square at y = 1 and a point 0.01 below the plane, 0.02 beside its edge x = 0.5,
+    // facing up: sampled by area, the estimate for the square's nearest corner of the edge was
+    // up to L A cos cos / d^2 ~ 1000 L; by solid angle it is at most L Omega / P(triangle).
+    scene::Mesh mesh;
+    mesh.positions = {{-0.5, 1, -0.5}, {0.5, 1, -0.5}, {0.5, 1, 0.5}, {-0.5, 1, 0.5}};
+    mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+    mesh.radiance = {1, 1, 1};
+    const auto light = prism::LightMesh<Real>::make(mesh, glm::dmat4(1.0), 0);
+    const glm::dvec3 from(0.52, 0.99, 0.1), normal(0, 1, 0);
+    // Lambert's formula for a polygon wholly above the receiver's plane: E = L / 2 sum over edges
+    // of the edge's angle times the normal's component along the edge's plane normal.
+    double lambert = 0;
+    for (int i = 0; i < 4; ++i) {
+        const glm::dvec3 v0 = glm::normalize(mesh.positions[std::size_t(i)] - from);
+        const glm::dvec3 v1 = glm::normalize(mesh.positions[std::size_t((i + 1) % 4)] - from);
+        lambert += std::acos(glm::dot(v0, v1)) * glm::dot(normal, glm::normalize(glm::cross(v0, v1)));
+    }
+    lambert = std::abs(lambert) / 2;
+    const prism::ShadingFrame<Real> at{prism::Vec3<Real>(from), prism::Vec3<Real>(normal)};
+    prism::Random random(13);
+    const int n = 200000;
+    double sum = 0, largest = 0;
+    for (int i = 0; i < n; ++i) {
+        const auto sample = light.sample(at, random.uniform2<Real>());
+        const double estimate = double(sample.radiance.g) * std::max(0.0, double(sample.direction.y));
+        sum += estimate;
+        largest = std::max(largest, estimate);
+    }
+    CHECK(sum / n == doctest::Approx(lambert).epsilon(0.005));
+    // Each triangle is chosen with probability 1/2 and subtends less than 2 pi.
+    CHECK(largest <= 4 * pi);
+}
+
+TEST_CASE_TEMPLATE("geometry: a hit on an emitting mesh names its triangle as the file and LightMesh number it", Real,
+                   float, double) {
+    // A 12 x 12 grid of 288 triangles (its own index reorders them) and an instance of it.
+    scene::Scene world;
+    world.materials.push_back({});
+    scene::Mesh grid;
+    const int cells = 12;
+    for (int j = 0; j <= cells; ++j)
+        for (int i = 0; i <= cells; ++i) grid.positions.push_back({i * 0.25, 2.0, j * 0.25});
+    for (int j = 0; j < cells; ++j)
+        for (int i = 0; i < cells; ++i) {
+            const std::uint32_t v = std::uint32_t(j * (cells + 1) + i);
+            grid.triangles.push_back({v, v + 1, v + cells + 2});
+            grid.triangles.push_back({v, v + cells + 2, v + cells + 1});
+        }
+    grid.radiance = {1, 1, 1};
+    world.meshes.push_back(grid);
+    world.mesh_instances.push_back({"again", 0, 0, glm::translate(glm::dmat4(1.0), glm::dvec3(10, 0, 0)), {}, {}});
+    using Policy = prism::WideBvh<prism::Watertight, 8>;
+    const prism::SceneGeometry<Real, Policy> geometry(world);
+    int reordered = 0;
+    for (std::uint32_t object = 0; object < 2; ++object)
+        for (std::uint32_t t = 0; t < grid.triangles.size(); ++t) {
+            const auto& face = grid.triangles[t];
+            const glm::dvec3 centroid = (grid.positions[face[0]] + grid.positions[face[1]] + grid.positions[face[2]]) / 3.0 +
+                                        glm::dvec3(object * 10.0, 0, 0);
+            prism::Ray<Real> ray(prism::Vec3<Real>(centroid - glm::dvec3(0, 1, 0)), prism::Vec3<Real>(0, 1, 0));
+            prism::Hit<Real> hit;
+            REQUIRE(prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::none));
+            CHECK(hit.object == object);
+            CHECK(geometry.emitting_triangle(hit) == t);
+            reordered += hit.primitive != t ? 1 : 0;
+        }
+    // Otherwise the mapping above would have nothing to do.
+    CHECK(reordered > 0);
 }
 
 TEST_CASE_TEMPLATE("LightMesh: its irradiance estimate matches the area light of the same rectangle", Real, float,

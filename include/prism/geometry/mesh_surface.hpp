@@ -48,6 +48,7 @@ public:
         };
         constexpr std::size_t grain = 16384;  // slots per task
         for_each_run(slots, grain, copy);
+        if (mesh.radiance != glm::dvec3(0.0) && !order.empty()) file_triangles_.assign(order.begin(), order.end());
         if (smooth_) vertex_normals_ = smooth_normals(mesh);
         for (const auto& uv : mesh.uvs) uvs_.emplace_back(uv);
     }
@@ -105,6 +106,12 @@ public:
         return true;
     }
 
+    // The file's number of the triangle in `slot`, for a mesh that emits (its LightMesh keeps
+    // the file's order); other meshes keep no table, and get `slot` back.
+    std::uint32_t file_triangle(std::uint32_t slot) const {
+        return slot < file_triangles_.size() ? file_triangles_[slot] : slot;
+    }
+
     // Whether culling skips the triangle in `slot` for a ray of this direction (object space):
     // the test the index's culled traversal makes.
     bool faces_away(std::uint32_t slot, const Vec3<Real>& direction) const {
@@ -141,6 +148,7 @@ private:
     // In slot order.
     HugePageVector<std::array<Vec3<Storage>, 3>> triangles_;
     std::vector<std::array<std::uint32_t, 3>> faces_;  // vertex indices
+    std::vector<std::uint32_t> file_triangles_;        // slot -> the file's triangle, for emitters
     std::vector<Vec3<Real>> vertex_normals_;
     std::vector<Vec2<Real>> uvs_;
 };

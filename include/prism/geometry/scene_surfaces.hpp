@@ -76,6 +76,12 @@ public:
     // The radiance object `object` (Hit::object) emits from its surface: a LightMesh's or
     // LightSphere's (and a LightMesh instance's), zero for every other object and for planes.
     Vec3<Real> emitted(std::uint32_t object) const { return object < emitted_.size() ? emitted_[object] : Vec3<Real>(0); }
+    // Which triangle of an emitting mesh (or mesh instance) `hit` found, as the file numbers
+    // them (LightMesh's order): a light's density of reaching the point depends on its triangle.
+    std::uint32_t emitting_triangle(const Hit<Real>& hit) const {
+        if (hit.object >= instances_.size() || instances_[hit.object].kind != Kind::mesh) return 0;
+        return meshes_[instances_[hit.object].shape].file_triangle(hit.primitive);
+    }
 
     // Two parts are left out for callers that never read them. `Parametrised` false leaves a
     // sphere's (u, v) and tangents zero: renderers compiled without textures never read them,

@@ -166,7 +166,7 @@ private:
         // light sample at the previous vertex (or is weighed against it, with MIS).
         bool count_emission = true;
         Real scatter_pdf = 0;        // the solid-angle density of the last BRDF-sampled direction
-        Vec3<Real> previous_position(0);
+        ShadingFrame<Real> previous;  // the last vertex, as next-event estimation saw it
         Real travelled = 0;
         for (int depth = 0;; ++depth) {
             Hit<Real> hit;
@@ -199,7 +199,7 @@ private:
                 else if (params.multiple_importance)
                     color += throughput * emitted *
                              path_tracing::power_heuristic(scatter_pdf,
-                                                           light_pdf(hit.object, previous_position, point));
+                                                           light_pdf(hit, previous, point));
             }
             if (depth >= settings_.max_recursion_depth) break;
 
@@ -253,7 +253,7 @@ private:
                 if (sampler.template uniform<Real>() >= survival) break;
                 throughput /= survival;
             }
-            previous_position = point.position;
+            previous = {point.position, normal};
             // In one store (stored_whole): the next intersect reads the ray whole.
             ray = stored_whole(leaving(point, normal, direction, ray.time));
         }
@@ -355,14 +355,15 @@ private:
         return glm::dot(normal, wi) > 0 ? 1 / (2 * pi<Real>) : Real(0);
     }
 
-    // The density next-event estimation gives to reaching `point` on object `object` from `from`.
-    Real light_pdf(std::uint32_t object, const Vec3<Real>& from, const SurfacePoint<Real>& point) const {
-        if (object >= emitters_.size()) return 0;
-        const Emitter& emitter = emitters_[object];
+    // The density next-event estimation at `from` gives to reaching `point`, found by `hit`.
+    Real light_pdf(const Hit<Real>& hit, const ShadingFrame<Real>& from, const SurfacePoint<Real>& point) const {
+        if (hit.object >= emitters_.size()) return 0;
+        const Emitter& emitter = emitters_[hit.object];
         if (const auto* meshes = lights_.template of_type<LightMesh>(); meshes && emitter.type == Emitter::mesh)
-            return (*meshes)[emitter.index].pdf(from, point.position, point.geometric_normal);
+            return (*meshes)[emitter.index].pdf(from, point.position, point.geometric_normal,
+                                                geometry_.emitting_triangle(hit));
         if (const auto* spheres = lights_.template of_type<LightSphere>(); spheres && emitter.type == Emitter::sphere)
-            return (*spheres)[emitter.index].pdf(from, point.position, point.geometric_normal);
+            return (*spheres)[emitter.index].pdf(from.position, point.position, point.geometric_normal);
         return 0;
     }
 
