@@ -287,7 +287,7 @@ TEST_CASE_TEMPLATE("geometry: a hit on an emitting mesh names its triangle as th
             const auto& face = grid.triangles[t];
             const glm::dvec3 centroid = (grid.positions[face[0]] + grid.positions[face[1]] + grid.positions[face[2]]) / 3.0 +
                                         glm::dvec3(object * 10.0, 0, 0);
-            prism::Ray<Real> ray(prism::Vec3<Real>(centroid - glm::dvec3(0, 1, 0)), prism::Vec3<Real>(0, 1, 0));
+            prism::Ray<Real> ray{prism::Vec3<Real>(centroid - glm::dvec3(0, 1, 0)), prism::Vec3<Real>(0, 1, 0)};
             prism::Hit<Real> hit;
             REQUIRE(prism::closest_hit(geometry, ray, hit, prism::BackfaceCulling::none));
             CHECK(hit.object == object);
