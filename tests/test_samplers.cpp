@@ -12,6 +12,8 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <set>
@@ -101,6 +103,59 @@ std::pair<double, bool> dimension_correlation(const Pattern& pattern, int sample
     return {correlation(a, b), in_range};
 }
 
+// ZSobol's numbers by their definition, one sample at a time (sampling/sobol.hpp): the index
+// (morton(x, y) << log2 spp) | sample with every base-4 digit, from the top, permuted by the
+// lexicographic permutation a hash of the original digits above it picks; with an odd log2, the
+// lowest (base-2) digit flipped by a hash bit; then Sobol' dimension 0 (and 1, for a pair)
+// Owen-scrambled with the dimension's keys. Nothing cached, nothing shared by a block.
+struct ZSobolReference {
+    int log2_samples, base4_digits;
+    prism::sampling::ZSobolKeys keys;
+
+    ZSobolReference(int samples, int width, int height, std::uint64_t seed) : keys(prism::sampling::ZSobolKeys::of(seed)) {
+        log2_samples = 0;
+        while ((1 << log2_samples) < samples) ++log2_samples;
+        int log2_side = 0;
+        while ((1 << log2_side) < std::max(width, height)) ++log2_side;
+        base4_digits = log2_side + (log2_samples + 1) / 2;
+    }
+    std::uint32_t index(int x, int y, int sample, int dimension) const {
+        using prism::mix_bits;
+        std::vector<std::array<std::uint32_t, 4>> permutations;
+        std::array<std::uint32_t, 4> p{0, 1, 2, 3};
+        do permutations.push_back(p);
+        while (std::next_permutation(p.begin(), p.end()));
+        const std::uint64_t salt = prism::sampling::dimension_key(keys.salt, dimension);
+        const std::uint64_t original =
+            (prism::sampling::morton_2d(std::uint32_t(x), std::uint32_t(y)) << log2_samples) | std::uint32_t(sample);
+        const bool odd = log2_samples & 1;
+        std::uint64_t shuffled = 0;
+        for (int digit = base4_digits - 1; digit >= int(odd); --digit) {
+            const int shift = 2 * digit - int(odd);
+            const std::uint64_t above = original >> (shift + 2);
+            const std::size_t permutation = std::size_t((mix_bits(above ^ salt) >> 40) % 24);
+            shuffled |= std::uint64_t(permutations[permutation][(original >> shift) & 3]) << shift;
+        }
+        if (odd) shuffled |= (original & 1) ^ (mix_bits((original >> 1) ^ salt) >> 63);
+        return std::uint32_t(shuffled);
+    }
+    template <class Real>
+    Real single(int x, int y, int sample, int dimension) const {
+        const auto key = std::uint32_t(prism::sampling::dimension_key(keys.single, dimension));
+        return prism::sampling::unit_from_bits<Real>(
+            prism::sampling::owen_scramble_reversed(index(x, y, sample, dimension), key));
+    }
+    template <class Real>
+    Vec2<Real> pair(int x, int y, int sample, int dimension) const {
+        const std::uint64_t key = prism::sampling::dimension_key(keys.pair, dimension);
+        const std::uint32_t i = index(x, y, sample, dimension);
+        const std::uint32_t second = prism::sampling::reverse_bits(prism::sampling::sobol_dimension1_bitwise(i));
+        return {prism::sampling::unit_from_bits<Real>(prism::sampling::owen_scramble_reversed(i, std::uint32_t(key))),
+                prism::sampling::unit_from_bits<Real>(
+                    prism::sampling::owen_scramble_reversed(second, std::uint32_t(key >> 32)))};
+    }
+};
+
 }  // namespace samplers_test
 
 using namespace samplers_test;
@@ -157,6 +212,52 @@ TEST_CASE_TEMPLATE("Samplers: ZSobol makes each pixel's samples a (0, m, 2)-net 
                 CHECK(is_net(points));
                 CHECK(one_per_stratum(singles));
             }
+        }
+    }
+}
+
+TEST_CASE_TEMPLATE("Samplers: ZSobol's blocks of samples draw each sample's numbers by their one-sample definition, bit for bit",
+                   Real, float, double) {
+    // Sample counts below, at and past a block, odd and even powers of two and neither; pixels
+    // at the corners; dimensions past the kept ones (cached_dimensions), each drawn as a single
+    // by some samples and in a pair by others; samples drawn in an order that leaves and
+    // revisits blocks, and a sampler copied midway.
+    for (const int samples : {1, 2, 3, 5, 8, 16, 37, 64, 256}) {
+        const prism::ZSobolPattern pattern(samples, 300, 200, 11);
+        const ZSobolReference reference(samples, 300, 200, 11);
+        for (const std::pair<int, int>& pixel : {std::pair{0, 0}, std::pair{299, 199}, std::pair{123, 45}}) {
+            const int x = pixel.first, y = pixel.second;
+            prism::ZSobolSampler sampler = pattern.for_pixel(x, y);
+            std::vector<int> order;
+            for (int s = samples - 1; s >= 0; s -= 2) order.push_back(s);
+            for (int s = samples - 2; s >= 0; s -= 2) order.push_back(s);
+            int mismatches = 0;
+            const auto draw = [&](prism::ZSobolSampler& drawing, int s) {
+                drawing.start_sample(s);
+                for (int dimension = 0; dimension < 72;) {
+                    if ((dimension + s) % 3 == 0) {
+                        mismatches += drawing.template uniform<Real>() != reference.template single<Real>(x, y, s, dimension);
+                        dimension += 1;
+                    } else {
+                        mismatches += drawing.template uniform2<Real>() != reference.template pair<Real>(x, y, s, dimension);
+                        dimension += 2;
+                    }
+                }
+            };
+            for (std::size_t k = 0; k < order.size(); ++k) {
+                if (k % 4 == 1) {
+                    // A copy made within a block (the sampler's last sample was in its block).
+                    prism::ZSobolSampler copy = sampler;
+                    draw(copy, order[k]);
+                    continue;
+                }
+                if (k == order.size() / 2) sampler = prism::ZSobolSampler(sampler);
+                draw(sampler, order[k]);
+            }
+            CAPTURE(samples);
+            CAPTURE(x);
+            CAPTURE(y);
+            CHECK(mismatches == 0);
         }
     }
 }
@@ -425,7 +526,7 @@ TEST_CASE_TEMPLATE("Samplers: a Config that fixes its sampler renders what the r
     CHECK(prism::Renderer<Chosen>(world, other).render(world.cameras[0]).pixels != fixed.pixels);
 }
 
-TEST_CASE("Samplers: Sobol' dimension 1 by byte tables equals it bit by bit") {
+TEST_CASE("Samplers: Sobol' dimension 1 by superset XORs equals it bit by bit") {
     std::uint32_t index = 0x12345678u;
     int differ = 0;
     for (int i = 0; i < 4096; ++i) {

@@ -13,6 +13,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -57,6 +58,14 @@ public:
     explicit constexpr ChosenSampler(const StratifiedSampler& sampler)
         : kind_(SamplerKind::stratified), stratified_(sampler) {}
     explicit constexpr ChosenSampler(const ZSobolSampler& sampler) : kind_(SamplerKind::sobol), sobol_(sampler) {}
+    // The chosen sampler's own copy (ZSobolSampler's leaves its block's points behind).
+    constexpr ChosenSampler(const ChosenSampler& other) : kind_(other.kind_) {
+        visit(other, [&](const auto& sampler) { std::construct_at(&member(sampler), sampler); });
+    }
+    constexpr ChosenSampler& operator=(const ChosenSampler& other) {
+        if (this != &other) std::construct_at(this, other);  // every member is trivially destroyed
+        return *this;
+    }
 
     constexpr void start_sample(int index) {
         visit(*this, [&](auto& sampler) { sampler.start_sample(index); });
@@ -81,6 +90,11 @@ public:
     }
 
 private:
+    // This sampler's member of the kind of `sampler`.
+    constexpr IndependentSampler& member(const IndependentSampler&) { return independent_; }
+    constexpr StratifiedSampler& member(const StratifiedSampler&) { return stratified_; }
+    constexpr ZSobolSampler& member(const ZSobolSampler&) { return sobol_; }
+
     SamplerKind kind_;
     union {
         IndependentSampler independent_;
