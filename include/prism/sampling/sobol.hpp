@@ -214,8 +214,7 @@ private:
     // each, dimension_key), and the shuffle of every index digit made of the pixel's bits, with
     // the highest digit made of the sample's bits, whose permutation is chosen by the pixel's
     // bits alone. Worked out once a pixel and dimension (for the first cached_dimensions), each
-    // sample then hashes only its lower digits: at 16 samples a pixel, one hash a draw instead of
-    // four (the keys, the salt and two digits).
+    // block of samples then hashes only the digits its samples differ in (point_indices).
     struct PixelDimension {
         std::uint64_t salt = 0, pair_key = 0;
         std::uint32_t single_key = 0;
