@@ -20,7 +20,7 @@
 #include <array>
 #include <bit>
 #include <cstdint>
-#include <tuple>
+#include <memory>
 #include <utility>
 
 namespace prism {
@@ -157,16 +157,7 @@ public:
           keys_(other.keys_), dimension_(other.dimension_), lane_(other.lane_), block_(other.block_),
           known_(other.known_), cache_(other.cache_) {}
     constexpr ZSobolSampler& operator=(const ZSobolSampler& other) {
-        morton_ = other.morton_;
-        log2_samples_ = other.log2_samples_;
-        base4_digits_ = other.base4_digits_;
-        keys_ = other.keys_;
-        dimension_ = other.dimension_;
-        lane_ = other.lane_;
-        block_ = other.block_;
-        known_ = other.known_;
-        cache_ = other.cache_;
-        pairs_known_ = singles_known_ = 0;
+        if (this != &other) std::construct_at(this, other);  // every member is trivially destroyed
         return *this;
     }
 
@@ -191,13 +182,9 @@ public:
 
     template <Scalar Real>
     constexpr Vec2<Real> uniform2() {
-        std::uint32_t x, y;
-        if (known(pairs_known_)) {
-            x = pairs_[std::size_t(dimension_)].x[std::size_t(lane_)];
-            y = pairs_[std::size_t(dimension_)].y[std::size_t(lane_)];
-        } else {
-            std::tie(x, y) = pair_worked_out();
-        }
+        const auto [x, y] = known(pairs_known_) ? std::pair(pairs_[std::size_t(dimension_)].x[std::size_t(lane_)],
+                                                            pairs_[std::size_t(dimension_)].y[std::size_t(lane_)])
+                                                : pair_worked_out();
         dimension_ += 2;
         return {sampling::unit_from_bits<Real>(x), sampling::unit_from_bits<Real>(y)};
     }
@@ -228,7 +215,7 @@ private:
     };
 
     // Whether the draw is kept in the block's points (dimensions below cached_dimensions).
-    constexpr bool cached() const { return dimension_ >= 0 && dimension_ < cached_dimensions; }
+    constexpr bool cached() const { return std::uint32_t(dimension_) < std::uint32_t(cached_dimensions); }  // negatives wrap past it
     // Whether the block's points of the current dimension are worked out (`mask`: singles_known_
     // or pairs_known_).
     constexpr bool known(std::uint64_t mask) const { return cached() && ((mask >> dimension_) & 1); }
@@ -238,14 +225,11 @@ private:
     // line, so that a draw of points already worked out is a load where the caller draws (one
     // draw in six on hw7 path_glass at 16 samples works a block out).
     [[gnu::noinline]] constexpr std::uint32_t single_worked_out() {
-        if (!cached()) {
-            std::array<std::uint32_t, lanes> block;
-            singles(pixel_dimension(), block);
-            return block[std::size_t(lane_)];
-        }
-        singles(pixel_dimension(), singles_[std::size_t(dimension_)]);
-        singles_known_ |= std::uint64_t(1) << dimension_;
-        return singles_[std::size_t(dimension_)][std::size_t(lane_)];
+        std::array<std::uint32_t, lanes> uncached;
+        std::array<std::uint32_t, lanes>& block = cached() ? singles_[std::size_t(dimension_)] : uncached;
+        singles(pixel_dimension(), block);
+        if (cached()) singles_known_ |= std::uint64_t(1) << dimension_;
+        return block[std::size_t(lane_)];
     }
     [[gnu::noinline]] constexpr std::pair<std::uint32_t, std::uint32_t> pair_worked_out() {
         Pairs uncached;
@@ -370,7 +354,7 @@ private:
     }
 
     constexpr const PixelDimension& pixel_dimension() {
-        if (dimension_ < 0 || dimension_ >= cached_dimensions) {
+        if (!cached()) {
             uncached_ = shared_by_samples(dimension_);
             return uncached_;
         }
