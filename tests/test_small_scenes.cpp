@@ -7,7 +7,9 @@
 // their indices (their traversal ray, their root's box test), find the same hits, ties on the
 // quads' diagonals and rays that start on or graze their boxes' faces included; and planes,
 // tested eight at a time, give what each plane's own test gives, one after another; and shadow
-// rays tested several at a time (one batch through occluded) get what each gets alone.
+// rays tested several at a time (one batch through occluded) get what each gets alone; and a
+// world index whose root has two leaves gives a batch's rays, a ray in each lane leaf after leaf,
+// the hits and answers each gets alone, ties on the edges the leaves share included.
 #include <prism/geometry/scene_geometry.hpp>
 #include <prism/material/material.hpp>
 
@@ -489,6 +491,51 @@ TEST_CASE_TEMPLATE("SceneGeometry: a world-space index whose root has two leaves
     };
     const prism::BackfaceCulling cullings[] = {prism::BackfaceCulling::none, prism::BackfaceCulling::triangles};
     std::size_t rays = 0, hits = 0, wall_hits = 0, blocked = 0, edge_rays = 0, lefts = 0;
+    // The same rays in batches (a row's camera rays, a row's shadow rays to one light), which
+    // the direct form tests a ray in each lane, leaf after leaf: each ray's answer must be the
+    // one it gets alone, for batches of 1 to 16 rays with gaps in the active mask.
+    REQUIRE(direct.route() == prism::BatchRoute::leaf_lanes);
+    struct Batch {
+        std::vector<prism::Ray<Real>> rays, alone;
+        std::vector<prism::Hit<Real>> hits;
+        std::vector<int> found, occluded;
+    };
+    Batch batches[2];
+    std::size_t batched = 0, batch_hits = 0;
+    const auto check_batch = [&](Batch& batch, prism::BackfaceCulling culling, std::uint32_t active) {
+        const int count = int(batch.rays.size());
+        std::vector<prism::Ray<Real>> rays = batch.rays;
+        std::vector<prism::Hit<Real>> got(static_cast<std::size_t>(count));
+        for (auto& hit : got) hit.object = 12345;  // left alone where a ray finds nothing
+        const std::uint32_t found = direct.intersect(prism::RayBatch<Real>{rays.data(), count, active, culling}, got.data());
+        std::uint32_t occluded = direct.occluded(prism::RayBatch<Real>{batch.rays.data(), count, active, culling});
+        CHECK((found & ~active) == 0);
+        CHECK((occluded & ~active) == 0);
+        for (int k = 0; k < count; ++k) {
+            CAPTURE(k);
+            const std::size_t j = std::size_t(k);
+            if (!((active >> k) & 1)) {
+                CHECK(same_bits(rays[j].t_max, batch.rays[j].t_max));
+                CHECK(got[j].object == 12345u);
+                continue;
+            }
+            ++batched;
+            CHECK(int((occluded >> k) & 1) == batch.occluded[j]);
+            REQUIRE(int((found >> k) & 1) == batch.found[j]);
+            CHECK(same_bits(rays[j].t_max, batch.alone[j].t_max));
+            if (!batch.found[j]) {
+                CHECK(got[j].object == 12345u);
+                continue;
+            }
+            ++batch_hits;
+            CHECK(same_bits(got[j].t, batch.hits[j].t));
+            CHECK(same_bits(got[j].b1, batch.hits[j].b1));
+            CHECK(same_bits(got[j].b2, batch.hits[j].b2));
+            CHECK(got[j].object == batch.hits[j].object);
+            CHECK(got[j].primitive == batch.hits[j].primitive);
+        }
+        batch = {};
+    };
     for (int i = 0; i < 100000; ++i) {
         glm::dvec3 origin, direction;
         switch (i % 4) {
@@ -543,6 +590,19 @@ TEST_CASE_TEMPLATE("SceneGeometry: a world-space index whose root has two leaves
             REQUIRE(found_a == found_b);
             const bool occluded = prism::blocked(direct, ray);
             CHECK(occluded == prism::blocked(indexed, ray));
+            Batch& batch = batches[culling == prism::BackfaceCulling::none ? 0 : 1];
+            batch.rays.push_back(ray);
+            batch.alone.push_back(a);
+            batch.hits.push_back(hit_a);
+            batch.found.push_back(found_a);
+            batch.occluded.push_back(occluded);
+            if (int(batch.rays.size()) == 1 + (i / 2) % 16) {
+                // Every ray active, or every third left out.
+                const int count = int(batch.rays.size());
+                std::uint32_t active = count == 32 ? ~0u : (std::uint32_t(1) << count) - 1;
+                if ((i / 32) % 2 == 1) active &= ~0x49249249u;
+                check_batch(batch, culling, active == 0 ? 1u : active);
+            }
             if (!found_a) continue;
             ++hits;
             blocked += occluded;
@@ -556,6 +616,8 @@ TEST_CASE_TEMPLATE("SceneGeometry: a world-space index whose root has two leaves
         }
     }
     CHECK(edge_rays > 40000);
+    CHECK(batched > rays * 2 / 3);
+    CHECK(batch_hits > batched / 2);
     CHECK(lefts > 10000);  // the boxes' test skipped leaves for many rays
     CHECK(hits > rays / 2);
     CHECK(wall_hits > rays / 3);

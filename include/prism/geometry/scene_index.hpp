@@ -151,8 +151,8 @@ public:
     // with triangle packets, a scene whose direct form tests its leaves and spheres with a ray
     // in each lane (intersection_batches) takes them so; a scene with an index (no direct form)
     // takes up to index_lanes rays through it together (the nodes' tests of several rays then
-    // overlap instead of each waiting on the one before); elsewhere (roots of two leaves or
-    // top-level meshes tested directly, no packets) the rays go one by one. So do batches of
+    // overlap instead of each waiting on the one before); elsewhere (top-level meshes tested
+    // directly, no packets) the rays go one by one. So do batches of
     // fewer than side_by_side_rays active rays, as Embree's hybrid traversal drops to single
     // rays when few stay active: a point's shadow rays to its two lights cost hw2
     // horse_and_glass_mug 1.11 times its time through the index together (lane set-up and
@@ -314,16 +314,18 @@ private:
         return blocked || planes_.occludes(ray);
     }
 
-    // Whether closest_dense tests its rays side by side: scenes without an index (direct_form_)
-    // whose world-space meshes, if any, are each one leaf, under the packed watertight test,
-    // and whose top level holds no mesh. The camera rays of hw1's small scenes (a floor of two
-    // triangles under spheres, spheres alone) are such rays. A root of two leaves keeps
-    // intersect's own tie rule (intersect_root_leaves); a top-level mesh (a transformed plate)
+    // Whether closest_dense tests its rays side by side: scenes without an index (direct_form_),
+    // under the packed watertight test, whose top level holds no mesh. The camera rays of hw1's
+    // small scenes (a floor of two triangles under spheres, spheres alone) are such rays, and
+    // so are the Cornell boxes' (a root of two to four leaves, tested leaf after leaf, a ray
+    // whose hits in two leaves tie traced again alone: intersect_root_leaves' rule); batches
+    // of their rays take 0.87-0.89 of the one-by-one time on hw1 cornellbox and ocornellbox
+    // (bench/RESULTS.md, "Whole renders"). A top-level mesh (a transformed plate)
     // needs each ray's may_hit for its lane, which the spheres' lanes would only repeat (hw2
     // simple_transform, two rotated meshes and a sphere: 1.04 of the CPU time with them).
     bool intersection_batches() const {
         if constexpr (Mesh::packed) {
-            if constexpr (Mesh::Packets::tests_ray_lanes) return direct_form_ && !several_leaves_ && !direct_.has_meshes();
+            if constexpr (Mesh::Packets::tests_ray_lanes) return direct_form_ && !direct_.has_meshes();
         }
         return false;
     }

@@ -88,8 +88,9 @@ inline typename Packets::LanePack SceneIndex<Real, Policy, MotionBlur>::lanes_t_
 // ray.t_max lowered to the hit and hits[i] filled, bit i of the answer set, where it hits
 // (count <= 32). BatchRoute::leaf_lanes: the world meshes' leaves are tested against several
 // rays at once (TriangleMesh::intersect_leaf_lanes, lane by lane the leaf test's bits),
-// group after group as closest_one takes them, then the direct spheres likewise
-// (intersect_direct_spheres_lanes), each ray then the planes on its own.
+// leaf after leaf of the root, then the direct spheres likewise
+// (intersect_direct_spheres_lanes), each ray then the planes on its own; a ray whose hits in
+// two leaves tie is traced again alone (closest_one), as intersect_root_leaves does.
 // BatchRoute::index_lanes: the rays traverse the index together (intersect_through_index).
 template <Scalar Real, class Policy, bool MotionBlur>
     requires AccelerationPolicy<Policy, Real>
@@ -113,48 +114,79 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::closest_dense(BatchRoute way
                 Hit<Real>* const group_hits = hits + first;
                 const int n = std::min(width, count - first);
                 std::optional<typename Packets::RayLanes> lanes_ray;  // made for the first leaf the rays may reach
-                std::uint32_t world_hits = 0;
+                std::uint32_t world_hits = 0, tied = 0;
+                // What a tied ray had before any leaf: it is traced again on its own from there.
+                Real given_t_max[width];
+                Hit<Real> given_hits[width];
                 for (const WorldMeshes& mesh_group : world_meshes_) {
-                    const typename Mesh::Leaf& leaf = mesh_group.leaves->leaf[0];
-                    const std::uint32_t lanes = lanes_reaching(leaf, group, n, 0);
-                    if (lanes == 0) continue;
-                    if (!lanes_ray) lanes_ray.emplace(group, n);
-                    typename Packets::LaneHits lane_hits;
-                    lane_hits.t_max = lanes_t_max<Packets>(group, n);
+                    const typename Mesh::RootLeaves& leaves = *mesh_group.leaves;
                     const Mesh& index = index_of(mesh_group);
-                    if (culls_back_faces(Culling))
-                        index.template intersect_leaf_lanes<true>(*lanes_ray, leaf, lanes, lane_hits);
-                    else
-                        index.template intersect_leaf_lanes<false>(*lanes_ray, leaf, lanes, lane_hits);
-                    std::uint32_t taken = lane_hits.found & lanes;
-                    if (taken == 0) continue;
-                    alignas(64) Real t[width], b1[width], b2[width];
-                    lane_hits.t_max.store(t);
-                    lane_hits.b1.store(b1);
-                    lane_hits.b2.store(b2);
-                    for (; taken != 0; taken &= taken - 1) {
-                        const int i = std::countr_zero(taken);
-                        Hit<Real>& hit = group_hits[i];
-                        group[i].t_max = t[i];
-                        hit.t = t[i];
-                        hit.primitive = lane_hits.slot[std::size_t(i)];
-                        hit.b1 = b1[i];
-                        hit.b2 = b2[i];
-                        if (mesh_group.index) mesh_group.attribute(index.source_triangle(hit.primitive), hit);
-                        else hit.object = mesh_group.objects[0];
-                        world_hits |= std::uint32_t(1) << i;
+                    typename Packets::LaneHits lane_hits;
+                    bool lane_hits_made = false;
+                    // The root's leaves in slot order, each lane's t_max lowered by the leaves
+                    // before (intersect_root_leaves tests each from the ray's own t_max: a
+                    // leaf's closest candidate is the same under the lowered one wherever it
+                    // is nearer, and is found at exactly the lowered t_max where it ties).
+                    for (int k = 0; k < leaves.count; ++k) {
+                        const typename Mesh::Leaf& leaf = leaves.leaf[std::size_t(k)];
+                        const std::uint32_t lanes = lanes_reaching(leaf, group, n, 0);
+                        if (lanes == 0) continue;
+                        if (!lanes_ray) {
+                            lanes_ray.emplace(group, n);
+                            for (int i = 0; i < n; ++i) {
+                                given_t_max[i] = group[i].t_max;
+                                given_hits[i] = group_hits[i];
+                            }
+                        }
+                        if (!lane_hits_made) {
+                            lane_hits.t_max = lanes_t_max<Packets>(group, n);
+                            lane_hits_made = true;
+                        }
+                        lane_hits.found = 0;
+                        if (culls_back_faces(Culling))
+                            index.template intersect_leaf_lanes<true>(*lanes_ray, leaf, lanes, lane_hits);
+                        else
+                            index.template intersect_leaf_lanes<false>(*lanes_ray, leaf, lanes, lane_hits);
+                        std::uint32_t taken = lane_hits.found & lanes;
+                        if (taken == 0) continue;
+                        alignas(64) Real t[width], b1[width], b2[width];
+                        lane_hits.t_max.store(t);
+                        lane_hits.b1.store(b1);
+                        lane_hits.b2.store(b2);
+                        for (; taken != 0; taken &= taken - 1) {
+                            const int i = std::countr_zero(taken);
+                            const std::uint32_t bit = std::uint32_t(1) << i;
+                            // Found at exactly the hit of an earlier leaf: which of the two a
+                            // traversal keeps depends on its order of visits.
+                            if ((world_hits & bit) && t[i] == group[i].t_max) tied |= bit;
+                            else tied &= ~bit;
+                            Hit<Real>& hit = group_hits[i];
+                            group[i].t_max = t[i];
+                            hit.t = t[i];
+                            hit.primitive = lane_hits.slot[std::size_t(i)];
+                            hit.b1 = b1[i];
+                            hit.b2 = b2[i];
+                            if (mesh_group.index) mesh_group.attribute(index.source_triangle(hit.primitive), hit);
+                            else hit.object = mesh_group.objects[0];
+                            world_hits |= bit;
+                        }
                     }
                 }
                 static_assert(width <= Direct::width, "a group of rays fits the direct lanes");
                 if (direct_.has_spheres()) direct_.intersect_spheres_lanes(group, group_hits, n, world_hits);
                 // No direct meshes (intersection_batches): the planes, ray by ray, where there are any.
-                if (planes_.empty()) {
-                    found |= world_hits << first;
-                    continue;
+                if (!planes_.empty())
+                    for (int i = 0; i < n; ++i)
+                        if (!((tied >> i) & 1) && planes_.template closest<Culling>(group[i], group_hits[i]))
+                            world_hits |= std::uint32_t(1) << i;
+                // The tied rays (an edge shared by two leaves), each traced again alone.
+                for (; tied != 0; tied &= tied - 1) {
+                    const int i = std::countr_zero(tied);
+                    group[i].t_max = given_t_max[i];
+                    group_hits[i] = given_hits[i];
+                    if (!closest_one<Culling>(group[i], group_hits[i])) world_hits &= ~(std::uint32_t(1) << i);
                 }
-                for (int i = 0; i < n; ++i)
-                    if (planes_.template closest<Culling>(group[i], group_hits[i]) || ((world_hits >> i) & 1))
-                        found |= std::uint32_t(1) << (first + i);
+                found |= world_hits << first;
             }
         }
     }
@@ -188,16 +220,17 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::occluded_dense(BatchRoute wa
                 std::uint32_t found = 0;
                 std::optional<typename Packets::RayLanes> lanes_ray;
                 std::optional<typename Packets::LanePack> t_max;
-                for (const WorldMeshes& mesh_group : world_meshes_) {
-                    const typename Mesh::Leaf& leaf = mesh_group.leaves->leaf[0];
-                    const std::uint32_t lanes = lanes_reaching(leaf, group, n, found);
-                    if (lanes == 0) continue;
-                    if (!lanes_ray) {
-                        lanes_ray.emplace(group, n);
-                        t_max = lanes_t_max<Packets>(group, n);
+                for (const WorldMeshes& mesh_group : world_meshes_)
+                    for (int k = 0; k < mesh_group.leaves->count; ++k) {
+                        const typename Mesh::Leaf& leaf = mesh_group.leaves->leaf[std::size_t(k)];
+                        const std::uint32_t lanes = lanes_reaching(leaf, group, n, found);
+                        if (lanes == 0) continue;
+                        if (!lanes_ray) {
+                            lanes_ray.emplace(group, n);
+                            t_max = lanes_t_max<Packets>(group, n);
+                        }
+                        found |= index_of(mesh_group).occluded_leaf_lanes(*lanes_ray, leaf, lanes, *t_max);
                     }
-                    found |= index_of(mesh_group).occluded_leaf_lanes(*lanes_ray, leaf, lanes, *t_max);
-                }
                 if (found != present && direct_.has_spheres())
                     direct_.template intersect_spheres_lanes<true>(group, nullptr, n, found);
                 // No direct meshes (intersection_batches): the planes, ray by ray, where there are any.
