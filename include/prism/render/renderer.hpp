@@ -63,7 +63,8 @@ public:
           integrator_(geometry_, lights_, materials_, textures_, environment_, Vec3<Real>(scene.ambient_light),
                       Vec3<Real>(scene.background_color),
                       IntegratorSettings{scene.max_recursion_depth, scene.shadow_ray_epsilon, settings.ray_offset,
-                                         settings.backface_culling}) {}
+                                         settings.backface_culling}),
+          moving_(features.motion_blur && scene::has_moving_objects(scene)) {}
 
     // A renderer holds references into itself (the integrator into geometry and lights).
     Renderer(const Renderer&) = delete;
@@ -116,6 +117,9 @@ private:
     // compile the streamed routes, which draw the camera samples from a Random first.
     static constexpr bool can_stream = std::is_constructible_v<PixelSamplerT, IndependentSampler>;
 
+    // Which of the camera's dimensions the render reads (camera_sample).
+    CameraReads camera_reads(const ThinLensCamera<Real>& lens) const { return {lens.has_aperture(), moving_}; }
+
     // The path a camera ray of pixel (x, y) carries, drawing from `sampler`. `spread` is
     // lens.pixel_spread(), computed once a render: two square roots and a division, which each
     // pixel waited for before its trace (a fifth of the per-row samples on hw1 simple_reflectance
@@ -155,7 +159,7 @@ private:
                     const int x = start + i;
                     PixelSamplerT& sampler = samplers.make(std::size_t(i), pattern.for_pixel(x, y));
                     sampler.start_sample(0);
-                    const CameraSample<Real> sample = camera_sample<Real>(sampler, true);
+                    const CameraSample<Real> sample = camera_sample<Real>(sampler, true, camera_reads(lens));
                     rays[std::size_t(i)] = stored_whole(
                         lens.ray(Real(x) + sample.pixel.x, Real(y) + sample.pixel.y, sample.lens, sample.time));
                 }
@@ -238,7 +242,7 @@ private:
             scratch.samples.resize(std::size_t(count));
             for (int i = 0; i < count; ++i) {
                 pixel_sampler.start_sample(i);
-                scratch.samples[std::size_t(i)] = camera_sample<Real>(pixel_sampler, false);
+                scratch.samples[std::size_t(i)] = camera_sample<Real>(pixel_sampler, false, camera_reads(lens));
             }
             return pixel_sampler;
         }();
@@ -370,6 +374,7 @@ private:
     EnvironmentT environment_;
     RendererSettings settings_;
     Integrator integrator_;
+    bool moving_;  // whether a ray's shutter instant matters: something in the scene moves
 };
 
 }  // namespace prism
