@@ -137,6 +137,9 @@ struct Options {
     std::vector<int> samples{1, 4, 16, 64, 256};
     int reference_samples = 8192;
     int runs = 3;
+    // The samplers' renders whose errors each point's error averages (seeds 0 to N - 1): one
+    // seed's error ratio on glossy_area_small at 16 samples ranged over 0.63-0.93 between seeds.
+    int error_seeds = 4;
     prism::SamplerKind sampler = prism::SamplerKind::independent;  // the RendererParams chart's
     fs::path shared = PRISM_SHARED_DIR;
     fs::path project = PRISM_SOURCE_DIR;
@@ -182,7 +185,8 @@ bool finite(const prism::Image& image) {
 struct Point {
     int samples = 0;
     Times cpu;
-    double error = 0;  // relative RMSE against the reference
+    double error = 0;  // relative RMSE against the reference (the samplers': root mean square over seeds)
+    double lowest = 0, highest = 0;  // the samplers' points: the seeds' smallest and largest errors
 };
 
 struct SceneResult {
@@ -340,6 +344,9 @@ fs::path sampler_scene_path(const SamplerScene& chart_scene, const Options& opti
 // ranks fireflies, not samplers.
 constexpr double firefly_share = 0.001;
 
+// The seeds of the samplers' reference halves, apart from the curves' seeds.
+constexpr std::uint64_t reference_seeds[2] = {1000, 1001};
+
 struct SamplerResult {
     std::vector<std::vector<Point>> points;  // [sampler][sample count]; time: the camera's render, wall
     int width = 0, height = 0;
@@ -367,8 +374,9 @@ SamplerResult measure_samplers(const SamplerScene& chart_scene, const Options& o
     SamplerResult result;
     const auto reference_start = Clock::now();
     const int half = std::max(1, options.reference_samples / 2);
-    const prism::Image a = render_first_camera(scene, options, half, 1, prism::SamplerKind::independent).image;
-    const prism::Image b = render_first_camera(scene, options, half, 2, prism::SamplerKind::independent).image;
+    // Seeds apart from the curves' (0 to error_seeds - 1).
+    const prism::Image a = render_first_camera(scene, options, half, reference_seeds[0], prism::SamplerKind::independent).image;
+    const prism::Image b = render_first_camera(scene, options, half, reference_seeds[1], prism::SamplerKind::independent).image;
     if (!finite(a) || !finite(b)) fail(chart_scene.name + ": the reference has a pixel that is not finite");
     prism::Image reference(a.width, a.height);
     for (std::size_t p = 0; p < reference.pixels.size(); ++p) reference.pixels[p] = 0.5f * (a.pixels[p] + b.pixels[p]);
@@ -402,8 +410,22 @@ SamplerResult measure_samplers(const SamplerScene& chart_scene, const Options& o
             }
         }
         for (std::size_t k = 0; k < all_samplers.size(); ++k) {
-            result.points[k][s].samples = options.samples[s];
-            result.points[k][s].error = relative_rmse(images[k], reference, firefly_share);
+            Point& point = result.points[k][s];
+            point.samples = options.samples[s];
+            // The error of seed 0's render, then of the other seeds' (untimed).
+            double squares = 0;
+            for (int seed = 0; seed < options.error_seeds; ++seed) {
+                const double error =
+                    seed == 0 ? relative_rmse(images[k], reference, firefly_share)
+                              : relative_rmse(render_first_camera(scene, options, options.samples[s], std::uint64_t(seed),
+                                                                  all_samplers[k])
+                                                  .image,
+                                              reference, firefly_share);
+                squares += error * error;
+                point.lowest = seed == 0 ? error : std::min(point.lowest, error);
+                point.highest = seed == 0 ? error : std::max(point.highest, error);
+            }
+            point.error = std::sqrt(squares / options.error_seeds);
         }
     }
     for (std::size_t k = 0; k < all_samplers.size(); ++k) {
@@ -434,16 +456,18 @@ std::string samplers_markdown(const std::vector<SamplerResult>& results, const O
           "(`prism::render_scene`: its own integrator and RendererParams, the shipped renderers) at `--scale "
        << options.scale << "`, with `--samples N --sampler S`; the reference: independent samples at "
        << options.reference_samples
-       << " samples per pixel, as two halves (seeds 1 and 2; the curves use seed 0). Error: relative RMSE "
+       << " samples per pixel, as two halves (seeds 1000 and 1001). Error: relative RMSE "
           "without the largest 0.1% of squared differences (fireflies: one render's full RMSE on path_glass "
-          "ranged over 0.67-3.0 between seeds). Time: the camera's render (wall, " << tbb::info::default_concurrency()
+          "ranged over 0.67-3.0 between seeds), the root mean square of " << options.error_seeds
+       << " renders' (seeds 0 to " << options.error_seeds - 1
+       << "; the ratios of one seed's errors ranged over 0.63-0.93 on glossy_area_small at 16 samples). Time: the camera's render (wall, " << tbb::info::default_concurrency()
        << " threads, loading and the BVH's build left out), median of " << options.runs
        << " runs after a warm-up, samplers interleaved. Every render repeated its first image bit for bit, every "
           "pixel is finite, every curve's error fell from the lowest sample count to the highest, and each reference's "
           "own error is at most a third of the smallest error shown.\n\n";
     md << "![samplers: error against time](chart/samplers.png)\n\n";
     md << "| scene | sampler |";
-    for (const int n : options.samples) md << " " << n << " spp: error, ms |";
+    for (const int n : options.samples) md << " " << n << " spp: error (seeds' range), ms |";
     md << " own error / independent's, 16 and 64 spp | time / independent's, highest count |\n|---|---|";
     for (std::size_t i = 0; i < options.samples.size(); ++i) md << "---|";
     md << "---|---|\n";
@@ -460,7 +484,8 @@ std::string samplers_markdown(const std::vector<SamplerResult>& results, const O
                                   : std::string())
                << " | " << prism::sampler_name(all_samplers[k]) << " |";
             for (const Point& point : result.points[k])
-                md << " " << format_number(point.error, 3) << ", " << std::fixed << std::setprecision(1)
+                md << " " << format_number(point.error, 3) << " (" << format_number(point.lowest, 2) << "-"
+                   << format_number(point.highest, 2) << "), " << std::fixed << std::setprecision(1)
                    << 1e3 * point.cpu.median() << std::defaultfloat << " |";
             std::string ratios;
             for (const int count : {16, 64})
@@ -678,6 +703,7 @@ const std::string end_marker = "<!-- sampling_chart:end -->";
 
 const char* usage =
     "usage: prism_sampling_chart [--scale S] [--samples N,N,...] [--reference-samples N] [--runs N]\n"
+    "                            [--error-seeds N]\n"
     "                            [--shared DIR] [--output-dir DIR] [--results RESULTS.md] [--command TEXT]\n"
     "                            [--revision TEXT]\n"
     "                            [--sampler independent|stratified|sobol] [--project DIR]\n"
@@ -687,7 +713,7 @@ const char* usage =
     "against a long independent render. Writes DIR/sampling.svg, DIR/samplers.svg, DIR/sampling.tsv\n"
     "and DIR/sampling.md, and replaces the marked section of RESULTS.md when given. Defaults:\n"
     "--scale 0.125, --samples 1,4,16,64,256, --reference-samples 8192, --runs 3 (timed runs after one\n"
-    "warm-up), --sampler independent, --shared " PRISM_SHARED_DIR ", --project " PRISM_SOURCE_DIR ".\n";
+    "warm-up), --error-seeds 4 (the samplers' renders whose errors a point averages), --sampler independent, --shared " PRISM_SHARED_DIR ", --project " PRISM_SOURCE_DIR ".\n";
 
 std::vector<int> parse_counts(const std::string& text) {
     std::vector<int> counts;
@@ -716,6 +742,7 @@ Options parse(int argc, char** argv) {
         else if (arg == "--samples") options.samples = parse_counts(value());
         else if (arg == "--reference-samples") options.reference_samples = std::stoi(value());
         else if (arg == "--runs") options.runs = std::stoi(value());
+        else if (arg == "--error-seeds") options.error_seeds = std::stoi(value());
         else if (arg == "--shared") options.shared = value();
         else if (arg == "--project") options.project = value();
         else if (arg == "--sampler") {
@@ -735,6 +762,7 @@ Options parse(int argc, char** argv) {
     }
     if (!(options.scale > 0.0 && options.scale <= 1.0)) fail("--scale must be in (0, 1]");
     if (options.runs < 1) fail("--runs must be at least 1");
+    if (options.error_seeds < 1 || options.error_seeds > 64) fail("--error-seeds must be in [1, 64]");
     if (options.reference_samples < 4 * options.samples.back() || options.reference_samples > 65536)
         fail("--reference-samples must be in [4 x the highest --samples, 65536]");
     if (options.command.empty()) options.command = "prism_sampling_chart";
