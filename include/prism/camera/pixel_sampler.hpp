@@ -70,13 +70,12 @@ CameraSample<Real> centre_sample(Random& random) {
 // camera_dimensions on.
 inline constexpr int camera_dimensions = 5;
 
-//
-// `reads` says which of them the render reads: the lens point only through an aperture, the
-// instant only where something moves. The others are skipped, not drawn: every dimension has
-// its own numbers in such a sampler, so the rest keep theirs and the image is the same, without
-// the work of drawing what no one reads (the lens pair and the instant were about 7% of the
-// render time on scenes/environment/latlong with ZSobol, whose first draw of a dimension works
-// out a block of samples).
+// camera_sample's `reads` says which of them the render reads: the lens point only through an
+// aperture, the instant only where something moves. The others are skipped, not drawn: every
+// dimension has its own numbers in such a sampler, so the rest keep theirs and the image is the
+// same, without the work of drawing what no one reads (the lens pair and the instant were
+// about 7% of the render time on scenes/environment/latlong with ZSobol, whose first draw of a
+// dimension works out a block of samples).
 struct CameraReads {
     bool lens = true, time = true;
 };

@@ -115,14 +115,14 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::closest_dense(BatchRoute way
                 const int n = std::min(width, count - first);
                 std::optional<typename Packets::RayLanes> lanes_ray;  // made for the first leaf the rays may reach
                 std::uint32_t world_hits = 0, tied = 0;
-                // What a tied ray had before any leaf: it is traced again on its own from there.
+                // What a ray had before its first leaf hit: a tied ray is traced again from there.
                 Real given_t_max[width];
                 Hit<Real> given_hits[width];
                 for (const WorldMeshes& mesh_group : world_meshes_) {
                     const typename Mesh::RootLeaves& leaves = *mesh_group.leaves;
                     const Mesh& index = index_of(mesh_group);
                     typename Packets::LaneHits lane_hits;
-                    bool lane_hits_made = false;
+                    lane_hits.t_max = lanes_t_max<Packets>(group, n);
                     // The root's leaves in slot order, each lane's t_max lowered by the leaves
                     // before (intersect_root_leaves tests each from the ray's own t_max: a
                     // leaf's closest candidate is the same under the lowered one wherever it
@@ -131,17 +131,7 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::closest_dense(BatchRoute way
                         const typename Mesh::Leaf& leaf = leaves.leaf[std::size_t(k)];
                         const std::uint32_t lanes = lanes_reaching(leaf, group, n, 0);
                         if (lanes == 0) continue;
-                        if (!lanes_ray) {
-                            lanes_ray.emplace(group, n);
-                            for (int i = 0; i < n; ++i) {
-                                given_t_max[i] = group[i].t_max;
-                                given_hits[i] = group_hits[i];
-                            }
-                        }
-                        if (!lane_hits_made) {
-                            lane_hits.t_max = lanes_t_max<Packets>(group, n);
-                            lane_hits_made = true;
-                        }
+                        if (!lanes_ray) lanes_ray.emplace(group, n);
                         lane_hits.found = 0;
                         if (culls_back_faces(Culling))
                             index.template intersect_leaf_lanes<true>(*lanes_ray, leaf, lanes, lane_hits);
@@ -156,11 +146,17 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::closest_dense(BatchRoute way
                         for (; taken != 0; taken &= taken - 1) {
                             const int i = std::countr_zero(taken);
                             const std::uint32_t bit = std::uint32_t(1) << i;
+                            Hit<Real>& hit = group_hits[i];
                             // Found at exactly the hit of an earlier leaf: which of the two a
                             // traversal keeps depends on its order of visits.
-                            if ((world_hits & bit) && t[i] == group[i].t_max) tied |= bit;
-                            else tied &= ~bit;
-                            Hit<Real>& hit = group_hits[i];
+                            if (!(world_hits & bit)) {
+                                given_t_max[i] = group[i].t_max;
+                                given_hits[i] = hit;
+                            } else if (t[i] == group[i].t_max) {
+                                tied |= bit;
+                            } else {
+                                tied &= ~bit;
+                            }
                             group[i].t_max = t[i];
                             hit.t = t[i];
                             hit.primitive = lane_hits.slot[std::size_t(i)];
