@@ -817,3 +817,93 @@ TEST_CASE_TEMPLATE("SceneGeometry: camera rays tested several at a time get what
         if (kind >= 1) CHECK(kinds_hit[1] > 100);
     }
 }
+
+TEST_CASE_TEMPLATE("SceneGeometry: moving spheres and plates in a direct top level find, at each ray's instant, what the index finds",
+                   Real, float, double) {
+    // Motion blur (the course's MotionBlur translation over the shutter interval) on a plain
+    // sphere (its lanes move each ray's origin back by the motion at the ray's instant), on the
+    // ellipsoid (a matrix after the shift: ray by ray) and, in one variant, on a transformed
+    // plate in the top level. The direct form (a bound around each sweep) must find what the
+    // same objects give through the top-level index, one ray at a time and in batches.
+    using Geometry = prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>, true>;
+    for (const bool plate : {false, true}) {
+        CAPTURE(plate);
+        scene::Scene world = few_spheres(true);
+        world.spheres[0].motion = {0.6, 0.2, -0.9};
+        world.spheres[2].motion = {-0.4, 0.5, 0.2};
+        if (plate) {
+            scene::Mesh moving;
+            moving.positions = {{-1, 0, -1}, {1, 0, -1}, {1, 0, 1}, {-1, 0, 1}};
+            moving.triangles = {{0, 2, 1}, {0, 3, 2}};
+            moving.transform = glm::rotate(glm::translate(glm::dmat4(1.0), glm::dvec3(1.5, -0.5, 2)), 0.6, glm::dvec3(1, 0, 0));
+            moving.motion = {0.3, 0.8, 0};
+            world.meshes.push_back(moving);
+        }
+        const Geometry direct(world), indexed(past_direct_limit(world, 5));
+        // The direct form (leaf lanes where the top level holds spheres alone) and the index.
+        REQUIRE(direct.route() == (plate ? prism::BatchRoute::ray_by_ray : prism::BatchRoute::leaf_lanes));
+        REQUIRE(indexed.route() == prism::BatchRoute::index_lanes);
+
+        std::mt19937 random(31);
+        std::uniform_real_distribution<double> uniform(-1, 1), fraction(0, 1);
+        std::size_t rays_tested = 0, moving_hits = 0;
+        for (int batch = 0; batch < 3000; ++batch) {
+            const int count = 1 + int(fraction(random) * 16);
+            std::array<prism::Ray<Real>, 16> rays;
+            for (int i = 0; i < count; ++i) {
+                const double time = fraction(random);
+                glm::dvec3 origin = 5.0 * glm::dvec3(uniform(random), uniform(random), uniform(random)), direction;
+                if ((batch + i) % 2 == 0) {
+                    // At a moving object where it is at the ray's instant, through or grazing.
+                    const scene::Sphere& sphere = world.spheres[(batch + i) % 4 < 2 ? 0 : 2];
+                    const glm::dvec3 target =
+                        glm::dvec3(sphere.transform * glm::dvec4(sphere.center + sphere.radius * random_unit(random), 1.0)) +
+                        time * sphere.motion;
+                    origin = target + (1 + 4 * fraction(random)) * random_unit(random);
+                    direction = glm::normalize(target - origin);
+                    if (i % 3 == 1) direction = glm::normalize(direction + 1e-4 * random_unit(random));
+                } else {
+                    direction = random_unit(random);
+                }
+                rays[std::size_t(i)] = prism::Ray<Real>{prism::Vec3<Real>(origin), prism::Vec3<Real>(direction), Real(0), Real(50)};
+                rays[std::size_t(i)].time = Real(time);
+                if (batch % 5 == 0) rays[std::size_t(i)].t_max = Real(6 * fraction(random));
+            }
+            std::array<prism::Ray<Real>, 16> batched = rays;
+            std::array<prism::Hit<Real>, 16> batch_hits;
+            const std::uint32_t found = direct.intersect(prism::RayBatch<Real>::all(batched.data(), count), batch_hits.data());
+            std::uint32_t blocked = 0;
+            for (int i = 0; i < count; ++i) {
+                CAPTURE(i);
+                ++rays_tested;
+                prism::Ray<Real> a = rays[std::size_t(i)], b = a;
+                prism::Hit<Real> hit_a, hit_b;
+                const bool found_a = prism::closest_hit(direct, a, hit_a), found_b = prism::closest_hit(indexed, b, hit_b);
+                REQUIRE(found_a == found_b);
+                REQUIRE(found_a == bool((found >> i) & 1));
+                const bool occluded = prism::blocked(direct, rays[std::size_t(i)]);
+                CHECK(occluded == prism::blocked(indexed, rays[std::size_t(i)]));
+                blocked |= std::uint32_t(occluded) << i;
+                if (!found_a) continue;
+                CHECK(same_bits(hit_a.t, hit_b.t));
+                CHECK(same_bits(a.t_max, b.t_max));
+                CHECK(same_bits(hit_a.t, batch_hits[std::size_t(i)].t));
+                CHECK(same_bits(a.t_max, batched[std::size_t(i)].t_max));
+                CHECK(hit_a.object == batch_hits[std::size_t(i)].object);
+                CHECK(hit_a.primitive == batch_hits[std::size_t(i)].primitive);
+                // Planes are numbered after the objects, so past the far spheres in the indexed scene.
+                const auto plane_or_object = [](const Geometry& geometry, std::uint32_t object) {
+                    return object >= geometry.instance_count() ? 1000 + (object - geometry.instance_count()) : std::size_t(object);
+                };
+                CHECK(plane_or_object(direct, hit_a.object) == plane_or_object(indexed, hit_b.object));
+                CHECK(hit_a.primitive == hit_b.primitive);
+                const std::size_t first_sphere = world.meshes.size();
+                moving_hits += hit_a.object == first_sphere || hit_a.object == first_sphere + 2 ||
+                               (plate && hit_a.object == world.meshes.size() - 1);
+            }
+            CHECK(direct.occluded(prism::RayBatch<Real>::all(rays.data(), count)) == blocked);
+        }
+        // The moving objects are met, not only missed.
+        CHECK(moving_hits > rays_tested / 5);
+    }
+}

@@ -60,8 +60,11 @@ public:
     DirectTopLevel(DirectTopLevel&&) = default;
     DirectTopLevel& operator=(DirectTopLevel&&) = default;
 
-    // Takes the top level's objects if there are at most `width`, none moves, and every mesh
-    // among them is one leaf; else stays unchosen. `meshes[shape]`: the index's mesh `shape`.
+    // Takes the top level's objects if there are at most `width` and every mesh among them is
+    // one leaf; else stays unchosen. `meshes[shape]`: the index's mesh `shape`. A moving object
+    // (motion blur) is tested at the ray's instant, as the index's leaf tests it, inside a
+    // bound around its sweep: hw3 cornellbox_dynamic's one moving sphere had sent its ten
+    // walls and two spheres through the top-level index.
     void choose(const scene::Scene& scene, std::span<const std::uint32_t> top_objects,
                 std::span<const Placement<Real>> placements, std::span<const SphereShape<Real>> spheres,
                 std::span<const std::optional<Mesh>> meshes) {
@@ -73,7 +76,6 @@ public:
         Bounds bounds;
         for (const std::uint32_t object : top_objects) {
             const Placement<Real>& placement = placements[object];
-            if (placement.moving) return;
             if (placement.kind == Kind::mesh) {
                 const Mesh& mesh = *meshes[placement.shape];
                 const std::optional<typename Mesh::Leaf> leaf = mesh.single_leaf();
@@ -85,6 +87,13 @@ public:
             direct.object = object;
             direct.shape = spheres[placement.shape];
             direct.placement = placement;
+            if (placement.moving) {
+                // Bounded as a mesh is, around its box, which covers the sweep.
+                direct.map = DirectSphere::Map::moving;
+                set_around_box(bounds, chosen.size(), placement.world_bounds);
+                chosen.push_back(direct);
+                continue;
+            }
             if (placement.transformed) {
                 direct.map = Mat3<Real>(placement.world_to_object) == Mat3<Real>(1) ? DirectSphere::Map::translation
                                                                                     : DirectSphere::Map::matrix;
@@ -110,16 +119,8 @@ public:
         // small transformed mesh are culled before the object-space transform and leaf test.
         // Without it, hw2 simple_transform (two rotated meshes, a sphere) took 1.3x the CPU
         // time of the index, whose world boxes had culled those rays.
-        for (std::size_t m = 0; m < chosen_meshes.size(); ++m) {
-            const Aabb<Real>& box = chosen_meshes[m].placement.world_bounds;
-            const glm::dvec3 low(box.min), high(box.max);
-            const glm::dvec3 exact_center = 0.5 * (low + high);
-            const Vec3<Real> center(exact_center);
-            // The half diagonal, plus how far rounding moved the centre, widened as above.
-            const double radius =
-                (0.5 * glm::length(high - low) + glm::length(glm::dvec3(center) - exact_center)) * (1 + 1e-3);
-            bounds.set(chosen.size() + m, center, radius);
-        }
+        for (std::size_t m = 0; m < chosen_meshes.size(); ++m)
+            set_around_box(bounds, chosen.size() + m, chosen_meshes[m].placement.world_bounds);
         spheres_ = std::move(chosen);
         meshes_ = std::move(chosen_meshes);
         bounds_ = bounds;
@@ -186,7 +187,7 @@ public:
     // lane and SphereShape::intersect computed with their operations in their order, so each
     // lane finds what closest's sphere loop finds for its ray (its t_max lowered, its
     // hit's t, primitive and object set, its bit of `found` set). Spheres mapped by a matrix
-    // (ellipsoids) are tested ray by ray. AnyHit: occludes' question instead, a hit
+    // (ellipsoids), moving or not, are tested ray by ray. AnyHit: occludes' question instead, a hit
     // below t_max (open) setting the lane's bit of `found`, and nothing else written.
     template <bool AnyHit = false>
     void intersect_spheres_lanes(std::conditional_t<AnyHit, const Ray<Real>*, Ray<Real>*> rays, Hit<Real>* hits,
@@ -226,7 +227,7 @@ public:
             if (may == 0) continue;
 
             const DirectSphere& sphere = spheres_[s];
-            if (sphere.map == DirectSphere::Map::matrix) {
+            if (sphere.map == DirectSphere::Map::matrix || (sphere.map == DirectSphere::Map::moving && sphere.placement.transformed)) {
                 for (; may != 0; may &= may - 1) {
                     const int i = std::countr_zero(may);
                     Real t;
@@ -252,11 +253,21 @@ public:
             // SphereShape::intersect, from the origin hit_sphere gives it.
             const SphereShape<Real>& shape = sphere.shape;
             Lanes oc[3];
-            for (int axis = 0; axis < 3; ++axis) {
-                const Lanes origin = sphere.map == DirectSphere::Map::translation
-                                              ? o[axis] + Lanes::broadcast(sphere.translation[axis])
-                                              : o[axis];
-                oc[axis] = origin - Lanes::broadcast(shape.center[axis]);
+            if (sphere.map == DirectSphere::Map::moving) {
+                // In world space here: as ray_to_object, each ray's origin moved back by the
+                // motion at its instant.
+                alignas(64) Real instants[width];
+                for (int lane = 0; lane < width; ++lane) instants[lane] = rays[lane < count ? lane : 0].time;
+                const Lanes time = Lanes::load(instants);
+                for (int axis = 0; axis < 3; ++axis)
+                    oc[axis] = (o[axis] - Lanes::broadcast(sphere.placement.motion[axis]) * time) - Lanes::broadcast(shape.center[axis]);
+            } else {
+                for (int axis = 0; axis < 3; ++axis) {
+                    const Lanes origin = sphere.map == DirectSphere::Map::translation
+                                                  ? o[axis] + Lanes::broadcast(sphere.translation[axis])
+                                                  : o[axis];
+                    oc[axis] = origin - Lanes::broadcast(shape.center[axis]);
+                }
             }
             const Lanes r2 = Lanes::broadcast(shape.radius * shape.radius);
             const Lanes half_b = dot(oc, d);
@@ -308,8 +319,8 @@ private:
         std::uint32_t object = 0;
         // How the ray reaches object space: unchanged, moved by `translation` (a transform that
         // only translates: the matrix product's answer, ox + tx with zero terms, bit for bit),
-        // or by the placement's matrix.
-        enum class Map : std::uint8_t { none, translation, matrix } map = Map::none;
+        // by the placement's matrix, or (moving) to where the sphere is at the ray's instant.
+        enum class Map : std::uint8_t { none, translation, matrix, moving } map = Map::none;
         Vec3<Real> translation{0};
         SphereShape<Real> shape;
         Placement<Real> placement;
@@ -339,6 +350,16 @@ private:
             lanes |= std::uint32_t(1) << lane;
         }
     };
+
+    // Lane `lane`'s sphere around a world box: the half diagonal, plus how far rounding moved
+    // the centre, widened by 0.1% as a sphere's bound is.
+    static void set_around_box(Bounds& bounds, std::size_t lane, const Aabb<Real>& box) {
+        const glm::dvec3 low(box.min), high(box.max);
+        const glm::dvec3 exact_center = 0.5 * (low + high);
+        const Vec3<Real> center(exact_center);
+        const double radius = (0.5 * glm::length(high - low) + glm::length(glm::dvec3(center) - exact_center)) * (1 + 1e-3);
+        bounds.set(lane, center, radius);
+    }
 
     // Which direct objects the ray may meet (bit i for sphere i, then the meshes' bits after
     // the spheres' as choose lays them out): lane by lane, false only where
@@ -375,6 +396,8 @@ private:
                 return sphere.shape.intersect(local, ray.t_min, t_max, t);
             }
             case DirectSphere::Map::matrix: break;
+            case DirectSphere::Map::moving:
+                return sphere.shape.intersect(sphere.placement.template ray_to_object<true>(ray), ray.t_min, t_max, t);
         }
         return sphere.shape.intersect(sphere.placement.to_object(ray), ray.t_min, t_max, t);
     }
@@ -391,7 +414,7 @@ private:
     }
     // A direct mesh's ray in its object space, or none where its leaf's box culls it there.
     PRISM_FORCE_INLINE static std::optional<Ray<Real>> mesh_ray(const DirectMesh& direct, const Ray<Real>& ray) {
-        const Ray<Real> local = direct.placement.template ray_to_object<false>(ray);
+        const Ray<Real> local = direct.placement.template ray_to_object<true>(ray);
         if (leaves_box(direct.leaf.box, local)) return std::nullopt;
         return local;
     }
