@@ -12,9 +12,11 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <random>
 #include <vector>
 
 #ifndef PRISM_SHARED_DIR
@@ -218,6 +220,42 @@ TEST_CASE_TEMPLATE("Perlin: the course's form equals Perlin 2002's lerps, is fix
     CHECK(high <= 1);
     CHECK(low < -0.5);  // the noise spans its range, not a constant
     CHECK(high > 0.5);
+}
+
+TEST_CASE_TEMPLATE("Perlin: the shared weights and hashes give the corner-by-corner sum bit for bit", Real, float, double) {
+    // The course's formula written corner by corner, each corner's offset, three weights and
+    // hash of its own, in the same order of operations: noise() shares them between corners
+    // and must change no image.
+    using Noise = PerlinNoise<Real>;
+    const auto corner_by_corner = [](const Vec3<Real>& p) {
+        const Vec3<Real> cell = glm::floor(p);
+        const int i = int(cell.x), j = int(cell.y), k = int(cell.z);
+        const Vec3<Real> f = p - cell;
+        const auto weight = [](Real t) {
+            const Real a = std::abs(t);
+            return 1 - a * a * a * (a * (a * 6 - 15) + 10);
+        };
+        const auto phi = [](int n) { return int(Noise::permutation[std::size_t(std::abs(n) % 16)]); };
+        Real sum = 0;
+        for (int corner = 0; corner < 8; ++corner) {
+            const int di = corner & 1, dj = (corner >> 1) & 1, dk = (corner >> 2) & 1;
+            const Vec3<Real> d = f - Vec3<Real>(Real(di), Real(dj), Real(dk));
+            const auto& g = Noise::gradients[std::size_t(phi(i + di + phi(j + dj + phi(k + dk))))];
+            sum += weight(d.x) * weight(d.y) * weight(d.z) * (Real(g[0]) * d.x + Real(g[1]) * d.y + Real(g[2]) * d.z);
+        }
+        return sum;
+    };
+    std::mt19937 random(3);
+    std::uniform_real_distribution<double> uniform(-40, 40);
+    int different = 0;
+    for (int n = 0; n < 200000; ++n) {
+        Vec3<Real> p(Real(uniform(random)), Real(uniform(random)), Real(uniform(random)));
+        if (n % 4 == 1) p = glm::floor(p);  // on lattice points and cell faces too
+        if (n % 4 == 2) p.y = std::floor(p.y);
+        const Real shared = Noise::noise(p), alone = corner_by_corner(p);
+        different += std::memcmp(&shared, &alone, sizeof(Real)) != 0;
+    }
+    CHECK(different == 0);
 }
 
 TEST_CASE_TEMPLATE("Perlin: the course's permutation and phi(n) = P[|n| mod 16], by hand", Real, float, double) {
