@@ -258,6 +258,32 @@ TEST_CASE_TEMPLATE("Perlin: the shared weights and hashes give the corner-by-cor
     CHECK(different == 0);
 }
 
+TEST_CASE_TEMPLATE("Perlin: a value and its three moved points in one pass are fractal()'s at each point, bit for bit", Real,
+                   float, double) {
+    // What a bump's forward differences take: the moved coordinates 10^-3 on (scaled), most in
+    // the point's cell and some past its face, where the corners' gradients change.
+    using Noise = PerlinNoise<Real>;
+    std::mt19937 random(5);
+    std::uniform_real_distribution<double> uniform(-40, 40), fraction(0, 1);
+    int different = 0, crossing = 0;
+    for (int n = 0; n < 100000; ++n) {
+        const Real scale = Real(0.25 + 4 * fraction(random));
+        Vec3<Real> p(Real(uniform(random)), Real(uniform(random)), Real(uniform(random)));
+        if (n % 3 == 1) p.x = std::ceil(p.x * scale) / scale - Real(1e-4);  // just below a cell face
+        const Real step = Real(1e-3);
+        const int octaves = 1 + n % 4;
+        const auto together = Noise::fractal_and_moved(p * scale, Vec3<Real>(p.x + step, p.y + step, p.z + step) * scale, octaves);
+        const std::array<Real, 4> apart{Noise::fractal(p * scale, octaves),
+                                        Noise::fractal((p + Vec3<Real>(step, 0, 0)) * scale, octaves),
+                                        Noise::fractal((p + Vec3<Real>(0, step, 0)) * scale, octaves),
+                                        Noise::fractal((p + Vec3<Real>(0, 0, step)) * scale, octaves)};
+        different += std::memcmp(together.data(), apart.data(), sizeof apart) != 0;
+        crossing += std::floor((p.x + step) * scale) != std::floor(p.x * scale);
+    }
+    CHECK(different == 0);
+    CHECK(crossing > 10000);  // the moved point leaves the cell in many of them
+}
+
 TEST_CASE_TEMPLATE("Perlin: the course's permutation and phi(n) = P[|n| mod 16], by hand", Real, float, double) {
     using Noise = PerlinNoise<Real>;
     CHECK(Noise::permutation == std::array<std::uint8_t, 16>{4, 10, 11, 15, 14, 5, 13, 1, 6, 9, 3, 7, 8, 2, 0, 12});

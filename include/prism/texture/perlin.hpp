@@ -49,23 +49,8 @@ public:
     // share (j, k) or k: 6 weights and 14 table steps where corner by corner took 24 and 24
     // (half the time a value, on hw4 perlin_types_bump a quarter of the render in its bumps).
     static Real noise(const Vec3<Real>& p) {
-        const Vec3<Real> cell = glm::floor(p);
-        const int i = int(cell.x), j = int(cell.y), k = int(cell.z);
-        const Vec3<Real> f = p - cell;  // position in the cell, [0, 1)^3
-        const Real dx[2] = {f.x, f.x - 1}, dy[2] = {f.y, f.y - 1}, dz[2] = {f.z, f.z - 1};
-        const Real wx[2] = {weight(dx[0]), weight(dx[1])}, wy[2] = {weight(dy[0]), weight(dy[1])},
-                   wz[2] = {weight(dz[0]), weight(dz[1])};
-        const int hk[2] = {phi(k), phi(k + 1)};
-        int hjk[2][2];  // phi(j + dj + phi(k + dk))
-        for (int dj = 0; dj < 2; ++dj)
-            for (int dk = 0; dk < 2; ++dk) hjk[dj][dk] = phi(j + dj + hk[dk]);
-        Real sum = 0;
-        for (int corner = 0; corner < 8; ++corner) {
-            const int di = corner & 1, dj = (corner >> 1) & 1, dk = (corner >> 2) & 1;
-            const auto& g = gradients[std::size_t(phi(i + di + hjk[dj][dk]))];
-            sum += wx[di] * wy[dj] * wz[dk] * (Real(g[0]) * dx[di] + Real(g[1]) * dy[dj] + Real(g[2]) * dz[dk]);
-        }
-        return sum;
+        const Axis x = axis(p.x), y = axis(p.y), z = axis(p.z);
+        return corner_sum(x, y, z, corner_gradients(x.cell, y.cell, z.cell));
     }
 
     // `octaves` octaves: sum over o of noise(2^o p) / 2^o. At least one.
@@ -80,12 +65,74 @@ public:
         return sum;
     }
 
+    // fractal() at p and, for each axis a, at p with coordinate a replaced by moved[a]: the far
+    // ends of a bump's forward differences, each bit for bit what fractal() gives at its point.
+    // The four points share the other two axes' offsets and weights, and the corners' gradients
+    // wherever a moved coordinate stays in p's cell, so the three differences cost about one
+    // value more, not three (the bumps of hw4 perlin_types_bump).
+    static std::array<Real, 4> fractal_and_moved(const Vec3<Real>& p, const Vec3<Real>& moved, int octaves) {
+        std::array<Real, 4> sums{};
+        Real amplitude = 1;
+        Vec3<Real> q = p, m = moved;
+        for (int o = 0; o < std::max(octaves, 1); ++o) {
+            const Axis x = axis(q.x), y = axis(q.y), z = axis(q.z);
+            const Axis moved_x = axis(m.x), moved_y = axis(m.y), moved_z = axis(m.z);
+            const Gradients here = corner_gradients(x.cell, y.cell, z.cell);
+            const auto at = [&](const Axis& a, const Axis& b, const Axis& c) {
+                const bool same_cell = a.cell == x.cell && b.cell == y.cell && c.cell == z.cell;
+                return corner_sum(a, b, c, same_cell ? here : corner_gradients(a.cell, b.cell, c.cell));
+            };
+            const std::array<Real, 4> values{corner_sum(x, y, z, here), at(moved_x, y, z), at(x, moved_y, z), at(x, y, moved_z)};
+            for (std::size_t k = 0; k < 4; ++k) sums[k] += amplitude * values[k];
+            amplitude *= Real(0.5);
+            q *= Real(2);
+            m *= Real(2);
+        }
+        return sums;
+    }
+
 private:
     // The course's falloff: 1 at the corner, 0 one cell away, with zero first and second
     // derivatives at both ends.
     static Real weight(Real t) {
         const Real a = std::abs(t);
         return 1 - a * a * a * (a * (a * 6 - 15) + 10);
+    }
+
+    // One coordinate of a point: its cell, and a corner's offset and weight along the axis,
+    // f and w(f) for the corner below (index 0), f - 1 and w(f - 1) for the one above.
+    struct Axis {
+        int cell;
+        Real offset[2], weight[2];
+    };
+    static Axis axis(Real coordinate) {
+        const Real cell = std::floor(coordinate);
+        const Real f = coordinate - cell;  // position in the cell, [0, 1)
+        return {int(cell), {f, f - 1}, {weight(f), weight(f - 1)}};
+    }
+
+    // The gradient numbers of a cell's 8 corners (corner = di + 2 dj + 4 dk).
+    using Gradients = std::array<std::uint8_t, 8>;
+    static Gradients corner_gradients(int i, int j, int k) {
+        const int hk[2] = {phi(k), phi(k + 1)};
+        int hjk[2][2];  // phi(j + dj + phi(k + dk))
+        for (int dj = 0; dj < 2; ++dj)
+            for (int dk = 0; dk < 2; ++dk) hjk[dj][dk] = phi(j + dj + hk[dk]);
+        Gradients numbers;
+        for (int corner = 0; corner < 8; ++corner)
+            numbers[std::size_t(corner)] = std::uint8_t(phi(i + (corner & 1) + hjk[(corner >> 1) & 1][(corner >> 2) & 1]));
+        return numbers;
+    }
+
+    static Real corner_sum(const Axis& x, const Axis& y, const Axis& z, const Gradients& numbers) {
+        Real sum = 0;
+        for (int corner = 0; corner < 8; ++corner) {
+            const int di = corner & 1, dj = (corner >> 1) & 1, dk = (corner >> 2) & 1;
+            const auto& g = gradients[numbers[std::size_t(corner)]];
+            sum += x.weight[di] * y.weight[dj] * z.weight[dk] *
+                   (Real(g[0]) * x.offset[di] + Real(g[1]) * y.offset[dj] + Real(g[2]) * z.offset[dk]);
+        }
+        return sum;
     }
 
     // phi(n) = P[|n| mod 16], as the course hashes: the noise at negative coordinates mirrors

@@ -285,10 +285,15 @@ private:
         if (texture.kind == scene::TextureKind::perlin) {
             const Real step = Real(1e-3);
             const Vec3<Real>& p = point.texture_position;
-            const Real h = noise(texture, p);
-            const Vec3<Real> gradient = Vec3<Real>(noise(texture, p + Vec3<Real>(step, 0, 0)) - h,
-                                                   noise(texture, p + Vec3<Real>(0, step, 0)) - h,
-                                                   noise(texture, p + Vec3<Real>(0, 0, step)) - h) / step;
+            // noise() at p and at p + step along each axis, in one pass over the octaves: the
+            // moved point's other coordinates are p's (p.y + 0 and p.y reach the same cell and
+            // offset, signed zeros included).
+            const auto values = PerlinNoise<Real>::fractal_and_moved(
+                p * texture.noise_scale,
+                Vec3<Real>(p.x + step, p.y + step, p.z + step) * texture.noise_scale, texture.num_octaves);
+            const auto converted = [&](std::size_t k) { return convert_noise(values[k], texture.noise_conversion); };
+            const Real h = converted(0);
+            const Vec3<Real> gradient = Vec3<Real>(converted(1) - h, converted(2) - h, converted(3) - h) / step;
             const Vec3<Real> surface_gradient = gradient - glm::dot(gradient, texture_normal) * texture_normal;
             const Vec3<Real> bumped = texture_normal - texture.bump_factor * surface_gradient;
             set_shading_normal(point, glm::transpose(glm::inverse(frame)) * bumped);
