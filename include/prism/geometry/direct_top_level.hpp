@@ -187,8 +187,9 @@ public:
     // lane and SphereShape::intersect computed with their operations in their order, so each
     // lane finds what closest's sphere loop finds for its ray (its t_max lowered, its
     // hit's t, primitive and object set, its bit of `found` set). Spheres mapped by a matrix
-    // (ellipsoids), moving or not, are tested ray by ray. AnyHit: occludes' question instead, a hit
-    // below t_max (open) setting the lane's bit of `found`, and nothing else written.
+    // (ellipsoids) and transformed spheres that move are tested ray by ray; a moving sphere in
+    // world space takes the lanes, each ray's origin moved back. AnyHit: occludes' question
+    // instead, a hit below t_max (open) setting the lane's bit of `found`, and nothing else written.
     template <bool AnyHit = false>
     void intersect_spheres_lanes(std::conditional_t<AnyHit, const Ray<Real>*, Ray<Real>*> rays, Hit<Real>* hits,
                                         int count, std::uint32_t& found) const {
