@@ -226,6 +226,42 @@ TEST_CASE_TEMPLATE("LightMesh: a mesh of more than 16 triangles chooses them by 
     CHECK(samplable < n - n / 10);
 }
 
+TEST_CASE_TEMPLATE("SphericalTriangle: samplable() answers as its solid angle does, at the smallest angle sampled too",
+                   Real, float, double) {
+    // Triangles of every shape, slivers among them, from viewpoints whose views range around
+    // smallest_solid_angle: the views it takes as certainly smaller without their arctangent
+    // (most of them) must be exactly those whose angle is smaller.
+    using prism::SphericalTriangle;
+    prism::Random random(17);
+    int near_bound = 0, small = 0;
+    const int count = 200000;
+    for (int k = 0; k < count; ++k) {
+        const auto point = [&] {
+            return glm::dvec3(random.uniform<double>() - 0.5, random.uniform<double>() - 0.5, random.uniform<double>() - 0.5);
+        };
+        const prism::Vec3<Real> v0(point() * 20.0), edge1(point()), edge2(k % 4 == 0 ? glm::dvec3(edge1) * 1.001 : point());
+        glm::dvec3 direction = point();
+        if (!(glm::length(direction) > 1e-3)) continue;
+        // The triangle's area over the squared distance, 0.01 to 1, bounds its solid angle.
+        const double area = glm::length(glm::cross(glm::dvec3(edge1), glm::dvec3(edge2))) / 2;
+        const double distance = std::sqrt(area / std::pow(10.0, 2 * random.uniform<double>() - 2));
+        const glm::dvec3 centroid = glm::dvec3(v0) + (glm::dvec3(edge1) + glm::dvec3(edge2)) / 3.0;
+        const prism::Vec3<Real> viewpoint(centroid + direction / glm::length(direction) * distance);
+        const SphericalTriangle view(viewpoint, v0, edge1, edge2);
+        const double omega = view.solid_angle();
+        CAPTURE(k);
+        CAPTURE(omega);
+        REQUIRE(view.samplable() ==
+                (omega >= SphericalTriangle::smallest_solid_angle && omega <= SphericalTriangle::largest_solid_angle));
+        small += omega < SphericalTriangle::smallest_solid_angle ? 1 : 0;
+        near_bound += omega >= SphericalTriangle::smallest_solid_angle && omega < 1.2 * SphericalTriangle::smallest_solid_angle;
+    }
+    // Both sides of the bound are well represented, and many views lie just above it.
+    CHECK(small > count / 4);
+    CHECK(small < count * 3 / 4);
+    CHECK(near_bound > count / 50);
+}
+
 TEST_CASE_TEMPLATE("LightMesh: beside the light its estimates stay bounded, and their mean is Lambert's irradiance",
                    Real, float, double) {
     // A unit square at y = 1 and a point 0.01 below the plane, 0.02 beside its edge x = 0.5,

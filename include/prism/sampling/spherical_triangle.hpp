@@ -47,9 +47,11 @@ public:
         : SphericalTriangle(Vec3<Real>(v0) - Vec3<Real>(viewpoint), Vec3<Real>(edge1), Vec3<Real>(edge2)) {}
 
     // The solid angle the triangle subtends, in steradians (0 for a degenerate view).
-    Real solid_angle() const { return solid_angle_; }
+    Real solid_angle() const { return small_ ? angle(determinant_, denominator_) : solid_angle_; }
     // Whether callers sample the triangle by its solid angle (see smallest_solid_angle).
-    bool samplable() const { return solid_angle_ >= smallest_solid_angle && solid_angle_ <= largest_solid_angle; }
+    bool samplable() const {
+        return !small_ && solid_angle_ >= smallest_solid_angle && solid_angle_ <= largest_solid_angle;
+    }
 
     // A unit direction towards the triangle, uniform in solid angle (density 1 / solid_angle()),
     // for u uniform in [0, 1)^2; for a view of positive area (solid_angle() in (0, 2 pi), as
@@ -72,12 +74,22 @@ private:
         determinant_ = glm::dot(ra, glm::cross(edge1, edge2));
         // Van Oosterom and Strackee (1983): tan(Omega / 2) = |det| / (la lb lc + (ra . rb) lc +
         // (ra . rc) lb + (rb . rc) la); atan2 keeps Omega above pi where the denominator is negative.
-        const Real denominator =
+        denominator_ =
             la_ * lb_ * lc_ + glm::dot(ra_, rb_) * lc_ + glm::dot(ra_, rc_) * lb_ + glm::dot(rb_, rc_) * la_;
+        // A view whose tangent is below smallest_solid_angle / 2 is smaller than that angle (atan x
+        // < x): samplable() is false without the arctangent, which solid_angle() works out only
+        // when asked. The comparison reads the values atan2 would, and its result would be below
+        // the bound by a relative 2e-4 or more, far beyond its rounding, so the answer is the one
+        // the angle gives. Most views of the hw7 Cornell boxes' light are that small; their
+        // arctangent (in double) was 3-5% of those renders' time (perf), and without it hw7
+        // path_glass and glossy_area_small take 0.98 of it (bench/paired.sh, 7 rounds).
+        small_ = denominator_ > 0 && std::abs(determinant_) < Real(smallest_solid_angle / 2) * denominator_;
         // A view with two vertices in one direction (no interior angle at a) has a zero
         // determinant, so a solid angle of 0 or 2 pi: never samplable().
-        solid_angle_ = 2 * std::atan2(std::abs(determinant_), denominator);
+        if (!small_) solid_angle_ = angle(determinant_, denominator_);
     }
+
+    static Real angle(Real determinant, Real denominator) { return 2 * std::atan2(std::abs(determinant), denominator); }
 
     Vec3<Real> sample_direction(Real u1, Real u2) const {
         const Vec3<Real> a = ra_ / la_, b = rb_ / lb_, c = rc_ / lc_;
@@ -90,7 +102,7 @@ private:
         const Real sin_alpha = std::abs(determinant_) / (la_ * lb_ * lc_ * lengths);
         // The sub-triangle a b c' of area u1 Omega. With s and t the sine and cosine of its
         // area less alpha, Arvo's closed form gives the cosine q of the arc a c'.
-        const Real sub_area = u1 * solid_angle_;
+        const Real sub_area = u1 * solid_angle();
         const Real sin_sub = std::sin(sub_area), cos_sub = std::cos(sub_area);
         const Real s = sin_sub * cos_alpha - cos_sub * sin_alpha;
         const Real t = cos_sub * cos_alpha + sin_sub * sin_alpha;
@@ -113,8 +125,9 @@ private:
     }
 
     Vec3<Real> ra_, rb_, rc_;  // from the viewpoint to the vertices
-    Real la_ = 0, lb_ = 0, lc_ = 0, determinant_ = 0;
+    Real la_ = 0, lb_ = 0, lc_ = 0, determinant_ = 0, denominator_ = 0;
     Real solid_angle_ = 0;
+    bool small_ = false;  // certainly below smallest_solid_angle, solid_angle_ not worked out
 };
 
 }  // namespace prism
