@@ -49,9 +49,7 @@ public:
     // The solid angle the triangle subtends, in steradians (0 for a degenerate view).
     Real solid_angle() const { return small_ ? angle(determinant_, denominator_) : solid_angle_; }
     // Whether callers sample the triangle by its solid angle (see smallest_solid_angle).
-    bool samplable() const {
-        return !small_ && solid_angle_ >= smallest_solid_angle && solid_angle_ <= largest_solid_angle;
-    }
+    bool samplable() const { return solid_angle_ >= smallest_solid_angle && solid_angle_ <= largest_solid_angle; }
 
     // A unit direction towards the triangle, uniform in solid angle (density 1 / solid_angle()),
     // for u uniform in [0, 1)^2; for a view of positive area (solid_angle() in (0, 2 pi), as
@@ -126,8 +124,8 @@ private:
 
     Vec3<Real> ra_, rb_, rc_;  // from the viewpoint to the vertices
     Real la_ = 0, lb_ = 0, lc_ = 0, determinant_ = 0, denominator_ = 0;
-    Real solid_angle_ = 0;
-    bool small_ = false;  // certainly below smallest_solid_angle, solid_angle_ not worked out
+    Real solid_angle_ = 0;  // left 0 where small_, which samplable() then reads as too small
+    bool small_ = false;    // certainly below smallest_solid_angle, solid_angle_ not worked out
 };
 
 }  // namespace prism
