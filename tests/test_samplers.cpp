@@ -222,7 +222,7 @@ TEST_CASE_TEMPLATE("Samplers: ZSobol's blocks of samples draw each sample's numb
     // at the corners; dimensions past the kept ones (cached_dimensions), each drawn as a single
     // by some samples and in a pair by others; samples drawn in an order that leaves and
     // revisits blocks, and a sampler copied midway.
-    for (const int samples : {1, 2, 3, 5, 8, 16, 37, 64, 256}) {
+    for (const int samples : {1, 2, 3, 5, 8, 16, 32, 37, 64, 128, 256}) {
         const prism::ZSobolPattern pattern(samples, 300, 200, 11);
         const ZSobolReference reference(samples, 300, 200, 11);
         for (const std::pair<int, int>& pixel : {std::pair{0, 0}, std::pair{299, 199}, std::pair{123, 45}}) {

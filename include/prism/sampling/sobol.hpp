@@ -145,13 +145,16 @@ public:
     // read theirs. One sample at a time, each draw waited for its own chain of hashes, bit
     // reversals and multiplications: 14% of hw7 path_glass's render and 22% of
     // scenes/environment/latlong's with this sampler (perf, 16 and 256 samples).
-    static constexpr int lane_bits = 3, lanes = 1 << lane_bits;
+    // Sixteen lanes, one 64-byte register of 32-bit values: at 16 samples a pixel one block is
+    // the pixel, so a dimension that few of its samples reach (a deep bounce) is worked out once
+    // a pixel rather than once for each half; blocks of 8 took 3% longer on path_glass.
+    static constexpr int lane_bits = 4, lanes = 1 << lane_bits;
 
     constexpr ZSobolSampler(std::uint64_t morton, int log2_samples, int base4_digits, const sampling::ZSobolKeys& keys)
         : morton_(morton), log2_samples_(log2_samples), base4_digits_(base4_digits), keys_(keys) {}
 
     // A copy draws what the original draws: it takes the pixel, the sample and its dimensions'
-    // shared parts, and works out its block's points again (8 KB it need not copy per pixel).
+    // shared parts, and works out its block's points again (14 KB it need not copy per pixel).
     constexpr ZSobolSampler(const ZSobolSampler& other)
         : morton_(other.morton_), log2_samples_(other.log2_samples_), base4_digits_(other.base4_digits_),
           keys_(other.keys_), dimension_(other.dimension_), lane_(other.lane_), block_(other.block_),
@@ -266,9 +269,9 @@ private:
     // 32-bit fraction (sobol_dimension0/1), as in any 32-bit Sobol' generator.
     // The block's samples differ only in their lowest lane_bits bits, so a digit above those is
     // the block's and is shuffled once for all of them; a digit within them is shuffled lane by
-    // lane, by a permutation that depends on at most the lane's bit 2 (two hashes), and the
-    // base-2 digit's flip on its bits 1 and 2 (four). Lane by lane, every digit took a hash: a
-    // block of 256-sample pixels hashed 24 times where 4 hashes are needed.
+    // lane, by a permutation that depends on at most the lane's bits 2 and 3 (four hashes), and
+    // the base-2 digit's flip on its bits 1 to 3 (eight). Lane by lane, every digit took a hash:
+    // a block of 256-sample pixels hashed 48 times where 6 hashes are needed.
     constexpr void point_indices(const PixelDimension& known, std::array<std::uint32_t, lanes>& shuffled) const {
         const std::uint64_t first = (morton_ << log2_samples_) | std::uint64_t(block_ * lanes);
         std::uint32_t block_digits = known.pixel_digits;
