@@ -5,6 +5,7 @@
 #include "temporary_folder.hpp"
 
 #include <prism/io/load.hpp>
+#include <prism/math/denormals.hpp>
 #include <prism/render/path_tracer.hpp>
 #include <prism/render/render_scene.hpp>
 
@@ -12,8 +13,10 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -411,6 +414,43 @@ TEST_CASE("PathTracer: the same seed gives the same image at 1 and 2 threads, wi
         CHECK(first[0].image.pixels == second[0].image.pixels);
         CHECK(log.str().find("path tracing") != std::string::npos);
     }
+}
+
+TEST_CASE_TEMPLATE("Renderer: tiles flush subnormals to zero, and the caller's floating-point mode holds in on_tile and after",
+                   Real, float, double) {
+    // math/denormals.hpp: GCC's 4-lane Vec3 arithmetic reads a stack word as its fourth lane,
+    // and a subnormal there costs an Intel core a microcode assist per multiplication. The
+    // render's tiles set DAZ and FTZ; the consumer's code (on_tile, and after render) must not.
+    const auto flushes = [] {
+        volatile Real tiny = std::numeric_limits<Real>::min() / 4;  // subnormal
+        const Real product = tiny * Real(1);
+        return product == 0;
+    };
+    REQUIRE_FALSE(flushes());  // this thread keeps IEEE subnormals
+#ifdef PRISM_HAS_MXCSR
+    {
+        const prism::FlushDenormals flush;
+        CHECK(flushes());
+    }
+#endif
+    CHECK_FALSE(flushes());
+    scene::Scene world = furnace();
+    world.cameras[0].num_samples = 4;
+    world.cameras[0].width = world.cameras[0].height = 40;  // several tiles
+    prism::RendererSettings settings;
+    settings.backface_culling = prism::BackfaceCulling::none;  // the camera is inside the cube
+    const prism::Renderer<PathConfig<Real>> renderer(world, settings);
+    std::atomic<int> tiles = 0, pixels = 0, flushed = 0;
+    const prism::Image image = renderer.render(world.cameras[0], 0, 0, [&](int tile_pixels) {
+        ++tiles;
+        pixels += tile_pixels;
+        if (flushes()) ++flushed;
+    });
+    CHECK(tiles > 1);
+    CHECK(pixels == 40 * 40);
+    CHECK(flushed == 0);
+    CHECK_FALSE(flushes());
+    CHECK(mean_of(image) > 1);  // the furnace rendered (1.875 when converged)
 }
 
 TEST_CASE("dispatch: the path tracer only for scenes with a path-traced camera") {

@@ -12,6 +12,7 @@
 #include <prism/image/image.hpp>
 #include <prism/io/limits.hpp>
 #include <prism/light/environment_light.hpp>
+#include <prism/math/denormals.hpp>
 #include <prism/memory/unconstructed.hpp>
 #include <prism/render/config.hpp>
 #include <prism/render/stored_whole.hpp>
@@ -87,15 +88,18 @@ public:
         Image image(width, height, Image::Unfilled{});  // every pixel is written below
         tbb::parallel_for(tbb::blocked_range2d<int>(0, height, tile_size, 0, width, tile_size),
                           [&](const tbb::blocked_range2d<int>& tile) {
-                              PixelScratch scratch;
-                              for (int y = tile.rows().begin(); y < tile.rows().end(); ++y) {
-                                  if (count == 1) {
-                                      one_sample_row(lens, camera, pattern, spread, y, tile.cols().begin(),
-                                                     tile.cols().end(), image);
-                                      continue;
+                              {
+                                  const FlushDenormals flush;  // math/denormals.hpp; restored before on_tile
+                                  PixelScratch scratch;
+                                  for (int y = tile.rows().begin(); y < tile.rows().end(); ++y) {
+                                      if (count == 1) {
+                                          one_sample_row(lens, camera, pattern, spread, y, tile.cols().begin(),
+                                                         tile.cols().end(), image);
+                                          continue;
+                                      }
+                                      for (int x = tile.cols().begin(); x < tile.cols().end(); ++x)
+                                          image(x, y) = pixel(lens, camera, pattern, spread, count, x, y, scratch);
                                   }
-                                  for (int x = tile.cols().begin(); x < tile.cols().end(); ++x)
-                                      image(x, y) = pixel(lens, camera, pattern, spread, count, x, y, scratch);
                               }
                               on_tile(int(tile.rows().size() * tile.cols().size()));
                           });
@@ -106,6 +110,7 @@ public:
     // lights and roughness are sampled from the first sample of pixel (0, 0), from its first
     // dimension.
     Vec3<Real> radiance(const Ray<Real>& ray) const {
+        const FlushDenormals flush;  // as render() computes it
         PixelSamplerT sampler = make_pattern<Pattern>({1, 1, 1, settings_.seed, settings_.sampler}).for_pixel(0, 0);
         sampler.start_sample(0);
         typename Integrator::CameraPath path{sampler, Vec2<Real>(Real(0.5))};
