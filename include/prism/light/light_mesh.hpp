@@ -176,9 +176,13 @@ private:
     // tangent plane (then so is the whole triangle, which cannot light it). Positive wherever a
     // triangle can add light, so the estimate stays unbiased.
     Real view_weights(const ShadingFrame<Real>& at, Weights& weights) const {
-        // One 64-byte register's lanes at a time (16 floats, 8 doubles): two registers' square
-        // root goes through GCC's AVX-512 intrinsics that warn falsely (GCC bug 105593).
-        constexpr int width = int(64 / sizeof(Real));
+        // One 32-byte register's lanes at a time (8 floats, 4 doubles). Not 64 bytes: a
+        // 512-bit square root and division lower an Intel core's clock for everything after
+        // them, and 32-byte lanes made hw7 path_diffuse and path_glass 0.90 and 0.89 of the
+        // 64-byte lanes' time on the Intel VM, the same images (bench/RESULTS.md, "Path
+        // tracer"). (Two 64-byte registers' square root also went through GCC's AVX-512
+        // intrinsics, which warn falsely: GCC bug 105593.)
+        constexpr int width = int(32 / sizeof(Real));
         static_assert(weighed_by_view % width == 0);
         using Lanes = simd::Pack<Real, width>;
         const Lanes px = Lanes::broadcast(at.position.x), py = Lanes::broadcast(at.position.y),
