@@ -9,13 +9,14 @@
 // subnormal float, and on Intel cores a multiplication or division with a subnormal operand
 // takes a microcode assist: 37 ns against under 1 ns for the same operation on normal numbers
 // (measured on this project's Xeon VM). On hw7 path_glass with the sobol sampler such lanes
-// cost 9% of the render (perf: most of it in the BRDF's kd / pi), with independent samples 1%.
+// cost 4% of the render (paired; perf puts most of it in the BRDF's kd / pi), with independent
+// samples about 1%.
 // The lane's value is never used; only its time is.
 //
 // What it changes in results: a value below 2^-126 (float) or 2^-1022 (double) becomes zero
 // where IEEE arithmetic keeps it. Radiance, distances and error bounds of a scene at any sane
-// scale are far above that: hw1-hw6 and hw4 VeachAjar render byte for byte as without it, in
-// float and double. The path tracer compares throughputs and densities with zero, and a path
+// scale are far above that: every course scene but hw7 path_glass renders byte for byte as
+// without it (hw1-hw2 in float and double; hw3-hw7 at reduced settings). The path tracer compares throughputs and densities with zero, and a path
 // whose weight has sunk below the smallest normal number now ends where it went on carrying
 // next to nothing; with the independent sampler the pixel's later samples then draw other
 // numbers. So five of hw7 path_glass's nine images differ, in 1 to 289 of their 16,384 pixels
