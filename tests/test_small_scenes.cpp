@@ -83,6 +83,19 @@ bool same_bits(Real a, Real b) {
     return std::memcmp(&a, &b, sizeof(Real)) == 0;
 }
 
+// Two closest hits of one ray, to the bit: the distance the ray was cut to, the triangle and
+// where on it.
+template <class Real>
+void check_same_hit(const prism::Ray<Real>& a, const prism::Hit<Real>& hit_a, const prism::Ray<Real>& b,
+                    const prism::Hit<Real>& hit_b) {
+    CHECK(same_bits(hit_a.t, hit_b.t));
+    CHECK(same_bits(a.t_max, b.t_max));
+    CHECK(same_bits(hit_a.b1, hit_b.b1));
+    CHECK(same_bits(hit_a.b2, hit_b.b2));
+    CHECK(hit_a.object == hit_b.object);
+    CHECK(hit_a.primitive == hit_b.primitive);
+}
+
 }  // namespace
 
 TEST_CASE_TEMPLATE("SceneGeometry: a top level of a few spheres tested directly finds what the index finds", Real, float,
@@ -606,12 +619,7 @@ TEST_CASE_TEMPLATE("SceneGeometry: a world-space index whose root has two leaves
             if (!found_a) continue;
             ++hits;
             blocked += occluded;
-            CHECK(same_bits(hit_a.t, hit_b.t));
-            CHECK(same_bits(a.t_max, b.t_max));
-            CHECK(same_bits(hit_a.b1, hit_b.b1));
-            CHECK(same_bits(hit_a.b2, hit_b.b2));
-            CHECK(hit_a.object == hit_b.object);
-            CHECK(hit_a.primitive == hit_b.primitive);
+            check_same_hit(a, hit_a, b, hit_b);
             wall_hits += hit_a.object < 5;
         }
     }
@@ -622,6 +630,66 @@ TEST_CASE_TEMPLATE("SceneGeometry: a world-space index whose root has two leaves
     CHECK(hits > rays / 2);
     CHECK(wall_hits > rays / 3);
     CHECK(blocked > rays / 3);
+}
+
+// A scene with a path-traced camera builds its world-space room (at most 64 triangles) with a
+// wall to a leaf (SceneIndex::world_max_leaf_size): another tree over the same triangles, so
+// every ray from the walls must find the same hit (the same distance, triangle and
+// barycentrics) and the same shadow-ray answer as through the builder's own leaves, the ray
+// tracer's shape of the same room; the ray tracer's scenes and larger rooms keep that shape.
+TEST_CASE_TEMPLATE("SceneGeometry: a path-traced room, a wall to a leaf, finds what the builder's leaves find", Real, float,
+                   double) {
+    using Geometry = prism::SceneGeometry<Real, prism::WideBvh<prism::Watertight, 8>>;
+    using Vec3 = prism::Vec3<Real>;
+    scene::Scene ray_traced = two_leaf_room();
+    ray_traced.cameras.push_back({});
+    scene::Scene path_traced = ray_traced;
+    path_traced.cameras.push_back({});
+    path_traced.cameras[1].renderer.path_tracing = true;
+    CHECK(Geometry::world_max_leaf_size(ray_traced) == 0);
+    REQUIRE(Geometry::world_max_leaf_size(path_traced) == 2);
+    scene::Scene hall = path_traced;  // 10 + 56 triangles: past a room
+    hall.meshes.push_back(hall.meshes[0]);
+    for (int i = 0; i < 27; ++i) hall.meshes.back().triangles.push_back(hall.meshes[0].triangles[std::size_t(i % 2)]);
+    REQUIRE(hall.meshes.back().triangles.size() == 29);
+    hall.meshes.push_back(hall.meshes.back());
+    CHECK(Geometry::world_max_leaf_size(hall) == 0);
+    hall.meshes.back().triangles.resize(25);  // 64
+    CHECK(Geometry::world_max_leaf_size(hall) == 2);
+
+    const Geometry builders(ray_traced), walls(path_traced);
+    REQUIRE(walls.merged_mesh_count() == 5);
+    CHECK(builders.route() == prism::BatchRoute::leaf_lanes);  // a root of two leaves, tested directly
+    CHECK(walls.route() != prism::BatchRoute::leaf_lanes);     // five leaves: through the index
+
+    std::mt19937 random(32);
+    std::uniform_real_distribution<double> uniform(-1, 1);
+    std::size_t rays = 0, hits = 0, blocked = 0;
+    for (int i = 0; i < 40000; ++i) {
+        // From a point of a wall (or just inside the room), every direction: the path tracer's
+        // bounces and shadow rays.
+        glm::dvec3 origin(9.9 * uniform(random), 9.9 * uniform(random), 9.9 * uniform(random));
+        if (i % 4 != 3) origin[std::size_t(i % 3)] = (i / 3) % 2 == 0 ? -10 : 10;
+        const glm::dvec3 direction = random_unit(random);
+        prism::Ray<Real> ray{Vec3(origin), Vec3(direction), Real(i % 4 == 3 ? 0 : 1e-3), Real(60)};
+        if (i % 2 == 0) ray.t_max = Real(25 * std::abs(uniform(random)));  // a shadow ray's length
+        for (const prism::BackfaceCulling culling : {prism::BackfaceCulling::none, prism::BackfaceCulling::triangles}) {
+            CAPTURE(i);
+            ++rays;
+            prism::Ray<Real> a = ray, b = ray;
+            prism::Hit<Real> hit_a, hit_b;
+            const bool found = prism::closest_hit(builders, a, hit_a, culling);
+            REQUIRE(found == prism::closest_hit(walls, b, hit_b, culling));
+            const bool occluded = prism::blocked(builders, ray);
+            CHECK(occluded == prism::blocked(walls, ray));
+            blocked += occluded;
+            if (!found) continue;
+            ++hits;
+            check_same_hit(a, hit_a, b, hit_b);
+        }
+    }
+    CHECK(hits > rays / 3);  // the room's front is open
+    CHECK(blocked > rays / 4);
 }
 
 // Shadow rays tested several at a time (a point's rays to its lights, a batch with gaps; a row's

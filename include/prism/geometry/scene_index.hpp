@@ -47,10 +47,11 @@ public:
         // translation a merged index's hits need (a cache miss per hit ray on the 766k-triangle
         // dragon: 5-9% of its camera rays' time).
         const bool alone = std::count(merged.begin(), merged.end(), true) == 1;
+        const std::uint32_t world_leaf_size = world_max_leaf_size(scene);
         meshes_.reserve(scene.meshes.size());
         for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
             if (merged[m] && !alone) meshes_.emplace_back(std::nullopt);
-            else meshes_.emplace_back(std::in_place, scene.meshes[m]);
+            else meshes_.emplace_back(std::in_place, scene.meshes[m], merged[m] ? world_leaf_size : 0);
         }
         placements_ = place_objects<Real>(
             scene, [&](std::size_t m) { return meshes_[m] ? meshes_[m]->bounds() : Mesh::bounds_of(scene.meshes[m]); },
@@ -69,7 +70,7 @@ public:
                 group.first_triangle.push_back(triangles);
                 triangles += std::uint32_t(scene.meshes[m].triangles.size());
             }
-            if (parts.size() > 1) group.index.emplace(std::span<const scene::Mesh* const>(parts));
+            if (parts.size() > 1) group.index.emplace(std::span<const scene::Mesh* const>(parts), world_leaf_size);
             if (!parts.empty()) world_meshes_.push_back(std::move(group));
         }
         std::vector<Aabb<Real>> boxes;
@@ -90,6 +91,30 @@ public:
         else top_ = Index::build(boxes);
         direct_.choose(scene, top_objects_, placements_, spheres_, meshes_);
         choose_direct_world_meshes();
+    }
+
+    // The leaves of the world-space index (0: its builder's choice). A scene with a path-traced
+    // camera whose world-space meshes are a room (at most 64 triangles: walls, a ceiling, a light
+    // box) gets leaves of at most two triangles, a rectangle each. The surface area heuristic
+    // weighs a box by the chance that a ray from outside meets it, and so puts a room's walls
+    // into one leaf whose box is the room; a path tracer's rays start on the walls (bounces, and
+    // next-event shadow rays), so every one of them tested that leaf's packet. With a wall to a
+    // leaf, a shadow ray from the floor to the light enters none of the walls' flat boxes. hw7
+    // path_diffuse and path_glass took 0.89 and 0.94 of the time, the same images (one triangle
+    // a leaf: 0.98 and 1.06; bench/RESULTS.md, "Path tracer"). Fabianowski, Fowler and
+    // Dingliana's cost for rays that start inside the scene (Eurographics 2009 short papers) is
+    // the general form. Not for the ray tracer's scenes: its rays are mostly camera rays, the
+    // hw1 Cornell boxes took 0.95-1.03 of the time that way, and three of their images changed
+    // where a ray meets two walls at the same distance (the leaves' order decides such ties).
+    static std::uint32_t world_max_leaf_size(const scene::Scene& scene) {
+        const std::vector<bool> merged = merged_meshes(scene);
+        constexpr std::size_t room_triangles = 64;
+        const bool path_traced =
+            std::any_of(scene.cameras.begin(), scene.cameras.end(), [](const scene::Camera& c) { return c.renderer.path_tracing; });
+        std::size_t triangles = 0;
+        for (std::size_t m = 0; m < scene.meshes.size(); ++m)
+            if (merged[m]) triangles += scene.meshes[m].triangles.size();
+        return path_traced && triangles <= room_triangles ? 2 : 0;
     }
 
     // The objects as this index placed them (place_objects), for the surfaces that pair with it.

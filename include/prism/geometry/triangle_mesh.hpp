@@ -39,14 +39,18 @@ public:
     using Packets = typename TrianglePacketsOf<Policy, Real>::type;
     static constexpr bool packed = !std::is_same_v<Packets, NoTrianglePackets>;
 
-    explicit TriangleMesh(const scene::Mesh& mesh) {
+    // `max_leaf_size` bounds the index's leaves (BvhBuildOptions::max_leaf_size); 0 leaves them
+    // to the index's own default and its surface area heuristic.
+    explicit TriangleMesh(const scene::Mesh& mesh, std::uint32_t max_leaf_size = 0) {
         const scene::Mesh* const parts[] = {&mesh};
-        build(parts);
+        build(parts, max_leaf_size);
     }
 
     // One index over the triangles of several meshes that share a space, numbered part after
     // part (part 0's triangles first). A hit's slot names its triangle through source_triangle.
-    explicit TriangleMesh(std::span<const scene::Mesh* const> parts) { build(parts); }
+    explicit TriangleMesh(std::span<const scene::Mesh* const> parts, std::uint32_t max_leaf_size = 0) {
+        build(parts, max_leaf_size);
+    }
 
     // The box of a mesh's triangles, as an index over them would bound them (each triangle's
     // box widened where Storage is wider than Real), without building the index.
@@ -324,9 +328,9 @@ public:
     }
 
 private:
-    void build(std::span<const scene::Mesh* const> parts) {
+    void build(std::span<const scene::Mesh* const> parts, std::uint32_t max_leaf_size) {
         for (const scene::Mesh* part : parts) triangle_count_ += part->triangles.size();
-        build_index(parts);
+        build_index(parts, max_leaf_size);
         // The packets hold the leaves' triangles: the plain copy would be read by nothing.
         if constexpr (packed) {
             triangles_.clear();
@@ -336,7 +340,7 @@ private:
 
     // The index over the parts' triangles (their boxes widened where Storage is wider than
     // Real), and the triangles copied into its slots, with their packets.
-    void build_index(std::span<const scene::Mesh* const> parts) {
+    void build_index(std::span<const scene::Mesh* const> parts, std::uint32_t max_leaf_size) {
         // Triangle i of the parts laid end to end: part p holds [first[p], first[p + 1]). Found
         // by search rather than kept per triangle (two pointer arrays of the triangle count).
         std::vector<std::uint32_t> first{0};
@@ -354,7 +358,15 @@ private:
         if constexpr (requires { Index::build(std::uint32_t(0), box_of); }) {
             // The index takes the boxes as they are made; its root box is the one the loop
             // below would find (the same boxes extended in the same order).
-            index_ = Index::build(std::uint32_t(triangle_count_), box_of);
+            if constexpr (requires { Index::build(std::uint32_t(0), box_of, BvhBuildOptions{}); }) {
+                if (max_leaf_size != 0) {
+                    index_ = Index::build(std::uint32_t(triangle_count_), box_of, BvhBuildOptions{.max_leaf_size = max_leaf_size});
+                } else {
+                    index_ = Index::build(std::uint32_t(triangle_count_), box_of);
+                }
+            } else {
+                index_ = Index::build(std::uint32_t(triangle_count_), box_of);
+            }
             bounds_ = index_.bounds();
         } else {
             std::vector<Aabb<Real>> boxes;
