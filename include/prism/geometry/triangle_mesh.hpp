@@ -40,7 +40,8 @@ public:
     static constexpr bool packed = !std::is_same_v<Packets, NoTrianglePackets>;
 
     // `max_leaf_size` bounds the index's leaves (BvhBuildOptions::max_leaf_size); 0 leaves them
-    // to the index's own default and its surface area heuristic.
+    // to the index's own default and its surface area heuristic (an index without leaves, the
+    // brute-force list, has nothing to bound).
     explicit TriangleMesh(const scene::Mesh& mesh, std::uint32_t max_leaf_size = 0) {
         const scene::Mesh* const parts[] = {&mesh};
         build(parts, max_leaf_size);
@@ -358,15 +359,12 @@ private:
         if constexpr (requires { Index::build(std::uint32_t(0), box_of); }) {
             // The index takes the boxes as they are made; its root box is the one the loop
             // below would find (the same boxes extended in the same order).
-            if constexpr (requires { Index::build(std::uint32_t(0), box_of, BvhBuildOptions{}); }) {
-                if (max_leaf_size != 0) {
-                    index_ = Index::build(std::uint32_t(triangle_count_), box_of, BvhBuildOptions{.max_leaf_size = max_leaf_size});
-                } else {
-                    index_ = Index::build(std::uint32_t(triangle_count_), box_of);
-                }
-            } else {
-                index_ = Index::build(std::uint32_t(triangle_count_), box_of);
-            }
+            const std::uint32_t count = std::uint32_t(triangle_count_);
+            if constexpr (requires { Index::build(count, box_of, BvhBuildOptions{}); })
+                index_ = max_leaf_size != 0 ? Index::build(count, box_of, BvhBuildOptions{.max_leaf_size = max_leaf_size})
+                                            : Index::build(count, box_of);
+            else
+                index_ = Index::build(count, box_of);
             bounds_ = index_.bounds();
         } else {
             std::vector<Aabb<Real>> boxes;
