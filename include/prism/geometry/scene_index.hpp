@@ -20,6 +20,7 @@
 #include <prism/geometry/sphere.hpp>
 #include <prism/geometry/triangle_mesh.hpp>
 #include <prism/memory/unconstructed.hpp>
+#include <prism/scene/needs.hpp>
 #include <prism/scene/scene.hpp>
 
 #include <algorithm>
@@ -47,7 +48,7 @@ public:
         // translation a merged index's hits need (a cache miss per hit ray on the 766k-triangle
         // dragon: 5-9% of its camera rays' time).
         const bool alone = std::count(merged.begin(), merged.end(), true) == 1;
-        const std::uint32_t world_leaf_size = world_max_leaf_size(scene);
+        const std::uint32_t world_leaf_size = world_max_leaf_size(scene, merged);
         meshes_.reserve(scene.meshes.size());
         for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
             if (merged[m] && !alone) meshes_.emplace_back(std::nullopt);
@@ -106,16 +107,7 @@ public:
     // the general form. Not for the ray tracer's scenes: its rays are mostly camera rays, the
     // hw1 Cornell boxes took 0.95-1.03 of the time that way, and three of their images changed
     // where a ray meets two walls at the same distance (the leaves' order decides such ties).
-    static std::uint32_t world_max_leaf_size(const scene::Scene& scene) {
-        const std::vector<bool> merged = merged_meshes(scene);
-        constexpr std::size_t room_triangles = 64;
-        const bool path_traced =
-            std::any_of(scene.cameras.begin(), scene.cameras.end(), [](const scene::Camera& c) { return c.renderer.path_tracing; });
-        std::size_t triangles = 0;
-        for (std::size_t m = 0; m < scene.meshes.size(); ++m)
-            if (merged[m]) triangles += scene.meshes[m].triangles.size();
-        return path_traced && triangles <= room_triangles ? 2 : 0;
-    }
+    static std::uint32_t world_max_leaf_size(const scene::Scene& scene) { return world_max_leaf_size(scene, merged_meshes(scene)); }
 
     // The objects as this index placed them (place_objects), for the surfaces that pair with it.
     std::span<const Placement<Real>> placements() const { return placements_; }
@@ -393,6 +385,15 @@ private:
     // from the top level. A mesh that a MeshInstance places keeps its own index for the
     // instance to use. Brute force (PrimitiveList) has no levels to save, and Embree's shapes
     // (accel/embree.hpp) keep one mesh per object.
+    // The same for the meshes merged_meshes chose, as the constructor has them.
+    static std::uint32_t world_max_leaf_size(const scene::Scene& scene, const std::vector<bool>& merged) {
+        constexpr std::size_t room_triangles = 64;
+        std::size_t triangles = 0;
+        for (std::size_t m = 0; m < scene.meshes.size(); ++m)
+            if (merged[m]) triangles += scene.meshes[m].triangles.size();
+        return scene::has_path_traced_camera(scene) && triangles <= room_triangles ? 2 : 0;
+    }
+
     static std::vector<bool> merged_meshes(const scene::Scene& scene) {
         std::vector<bool> merged(scene.meshes.size(), false);
         if constexpr (std::is_same_v<Index, PrimitiveList<Real>>) return merged;

@@ -13,16 +13,16 @@
 // samples about 1%.
 // The lane's value is never used; only its time is.
 //
-// What it changes in results: a value below 2^-126 (float) or 2^-1022 (double) becomes zero
-// where IEEE arithmetic keeps it. Radiance, distances and error bounds of a scene at any sane
-// scale are far above that: every course scene but hw7 path_glass renders byte for byte as
-// without it (hw1-hw2 in float and double; hw3-hw7 at reduced settings). The path tracer compares throughputs and densities with zero, and a path
-// whose weight has sunk below the smallest normal number now ends where it went on carrying
-// next to nothing; with the independent sampler the pixel's later samples then draw other
-// numbers. So five of hw7 path_glass's nine images differ, in 1 to 289 of their 16,384 pixels
-// at a quarter scale and 16 samples, within the noise (bench/RESULTS.md, "Sobol's cost a
-// sample"). The consumer's own code is not affected: the bits are restored when the scope
-// ends, and the Renderer ends it before calling back into the consumer (on_tile).
+// What it changes in results: a value below 2^-126 (float) or 2^-1022 (double) becomes zero where
+// IEEE arithmetic keeps it. Radiance, distances and error bounds of a scene at any sane scale are
+// far above that: every course scene but hw7 path_glass renders byte for byte as without it
+// (hw1-hw2 in float and double; hw3-hw7 at reduced settings). The path tracer compares throughputs
+// and densities with zero, and a path whose weight has sunk below the smallest normal number now
+// ends where it went on carrying next to nothing; with the independent sampler the pixel's later
+// samples then draw other numbers. So five of hw7 path_glass's nine images differ, in 1 to 289 of
+// their 16,384 pixels at a quarter scale and 16 samples, within the noise (bench/RESULTS.md,
+// "Sobol's cost a sample"). The consumer's own code is not affected: the bits are restored when
+// the scope ends, and the Renderer ends it before calling back into the consumer (on_tile).
 #pragma once
 
 #if defined(__SSE__) || defined(_M_X64)

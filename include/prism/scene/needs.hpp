@@ -91,13 +91,17 @@ inline bool has_moving_objects(const Scene& scene) {
     return moving(scene.meshes) || moving(scene.spheres) || moving(scene.mesh_instances);
 }
 
+inline bool has_path_traced_camera(const Scene& scene) {
+    return std::any_of(scene.cameras.begin(), scene.cameras.end(),
+                       [](const Camera& camera) { return camera.renderer.path_tracing; });
+}
+
 inline Needs measure_needs(const Scene& scene) {
     Needs needs;
     needs.lights = light_kinds(scene);
     needs.textures = !scene.textures.empty();
     needs.motion_blur = has_moving_objects(scene);
-    needs.path_tracing = std::any_of(scene.cameras.begin(), scene.cameras.end(),
-                                     [](const Camera& camera) { return camera.renderer.path_tracing; });
+    needs.path_tracing = has_path_traced_camera(scene);
     return needs;
 }
 
