@@ -495,17 +495,16 @@ TEST_CASE_TEMPLATE("Venice sunset: importance sampling beats cosine sampling fac
 
 TEST_CASE("EnvironmentLight and EnvironmentBackground from a scene") {
     scene::Scene description;
-    description.images.push_back({"sky.exr", std::make_shared<const prism::Image>(filled(8, 4, glm::vec3(2.0f))), true});
+    const auto sky = std::make_shared<const prism::Image>(filled(8, 4, glm::vec3(2.0f)));
+    description.images.push_back({"sky.exr", std::make_shared<const prism::Texels>(sky), true});
     description.environment_lights.push_back({"1", 0, Layout::latlong, Sampling::importance, {1.0, 0.5, 0.25}});
     CHECK(prism::scene::light_kinds(description) == prism::scene::bit(prism::EnvironmentLight<float>::kind));
     const auto lights = prism::EnvironmentLight<double>::from_scene(description);
     REQUIRE(lights.size() == 1);
     CHECK(lights[0].background({0, 0, -1}) == Vec3<double>(2.0, 1.0, 0.5));  // the scale applies
     // The light reads the scene's decoded image itself, not a copy.
-    CHECK(prism::EnvironmentLight<float>::map_of(description, description.environment_lights[0]).shared_image() ==
-          description.images[0].pixels);
-    CHECK(prism::EnvironmentLight<double>::map_of(description, description.environment_lights[0]).shared_image() ==
-          description.images[0].pixels);
+    CHECK(prism::EnvironmentLight<float>::map_of(description, description.environment_lights[0]).shared_image() == sky);
+    CHECK(prism::EnvironmentLight<double>::map_of(description, description.environment_lights[0]).shared_image() == sky);
 
     const prism::EnvironmentBackground<float> background(description), shared(prism::EnvironmentLight<float>::from_scene(description));
     CHECK(background.present());

@@ -36,7 +36,7 @@ scene::Scene sphere_under(const prism::Image& image, Layout layout, Sampling sam
     matte.diffuse = glm::dvec3(kd);
     world.materials.push_back(matte);
     world.spheres.push_back({"ball", 0, {0, 0, 0}, 1, glm::dmat4(1.0)});
-    world.images.push_back({"environment.exr", std::make_shared<const prism::Image>(image), true});
+    world.images.push_back({"environment.exr", std::make_shared<const prism::Texels>(image), true});
     world.environment_lights.push_back({"sky", 0, layout, sampling, {1, 1, 1}});
     return world;
 }

@@ -449,7 +449,7 @@ TEST_CASE_TEMPLATE("Renderer: a pixel's samples lit side by side (radiances_at) 
     prism::Image stripes(4, 4);
     for (int y = 0; y < 4; ++y)
         for (int x = 0; x < 4; ++x) stripes(x, y) = glm::vec3(float(x) / 4, 0.5f, float(y) / 4);
-    world.images.push_back({"in-code", std::make_shared<const prism::Image>(std::move(stripes)), false});
+    world.images.push_back({"in-code", std::make_shared<const prism::Texels>(std::move(stripes)), false});
     scene::Texture painted;
     painted.kind = scene::TextureKind::image;
     painted.decal_mode = scene::DecalMode::replace_all;

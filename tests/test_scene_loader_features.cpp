@@ -76,7 +76,7 @@ std::vector<std::string> compare_features(const Scene& a, const Scene& b) {
     check(a.images.size() == b.images.size(), "image count");
     for (std::size_t i = 0; i < std::min(a.images.size(), b.images.size()); ++i) {
         check(a.images[i].path == b.images[i].path, "image path");
-        check(a.images[i].pixels->pixels == b.images[i].pixels->pixels, "image pixels");
+        check(a.images[i].texels->radiance()->pixels == b.images[i].texels->radiance()->pixels, "image pixels");
         check(a.images[i].high_dynamic_range == b.images[i].high_dynamic_range, "image range");
     }
     check(a.textures.size() == b.textures.size(), "texture count");
@@ -287,11 +287,13 @@ TEST_CASE("2020+ textures: images decoded once, every TextureMap element, refere
     REQUIRE(scene.images.size() == 2);
     CHECK(scene.images[0].path.filename() == "small.png");
     CHECK(!scene.images[0].high_dynamic_range);
-    REQUIRE(scene.images[0].pixels->width == 2);
-    CHECK((*scene.images[0].pixels)(0, 0) == glm::vec3(10.0f, 20.0f, 30.0f));
-    CHECK((*scene.images[0].pixels)(1, 0) == glm::vec3(255.0f, 0.0f, 128.0f));
+    REQUIRE(scene.images[0].texels->width() == 2);
+    CHECK(scene.images[0].texels->bytes());  // 3 bytes a texel, read as floats
+    CHECK((*scene.images[0].texels)(0, 0) == glm::vec3(10.0f, 20.0f, 30.0f));
+    CHECK((*scene.images[0].texels)(1, 0) == glm::vec3(255.0f, 0.0f, 128.0f));
     CHECK(scene.images[1].high_dynamic_range);
-    CHECK((*scene.images[1].pixels)(0, 0) == glm::vec3(1000.5f, 0.25f, 3.0f));
+    CHECK(!scene.images[1].texels->bytes());
+    CHECK((*scene.images[1].texels)(0, 0) == glm::vec3(1000.5f, 0.25f, 3.0f));
 
     using namespace prism::scene;
     REQUIRE(scene.textures.size() == 5);

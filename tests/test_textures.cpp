@@ -9,6 +9,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdlib>
 #include <cstdint>
@@ -59,7 +60,7 @@ scene::Material grey_material() {
 // A scene holding one image and one texture reading it.
 scene::Scene scene_with_image_texture(Image pixels, scene::DecalMode mode, bool high_dynamic_range = false) {
     scene::Scene scene;
-    scene.images.push_back({"in-code", std::make_shared<const Image>(std::move(pixels)), high_dynamic_range});
+    scene.images.push_back({"in-code", std::make_shared<const Texels>(std::move(pixels)), high_dynamic_range});
     scene::Texture texture;
     texture.kind = scene::TextureKind::image;
     texture.decal_mode = mode;
@@ -143,7 +144,7 @@ TEST_CASE_TEMPLATE("MipMap and TextureSet share the scene's decoded image, never
     const auto image = std::make_shared<const Image>(grey_image(4, 2, [](int x, int y) { return x + 4 * y; }));
     for (const bool pyramid : {false, true}) {
         const MipMap<Real> map(image, pyramid);
-        CHECK(&map.level(0) == image.get());
+        CHECK(map.base().radiance() == image);
         CHECK(map.levels() == (pyramid ? 3 : 1));
     }
     CHECK(image.use_count() == 1);
@@ -152,10 +153,46 @@ TEST_CASE_TEMPLATE("MipMap and TextureSet share the scene's decoded image, never
     scene.textures.push_back(scene.textures[0]);
     {
         const TextureSet<Real> set(scene);
-        CHECK(scene.images[0].pixels.use_count() == 2);
+        CHECK(scene.images[0].texels.use_count() == 2);
     }
-    CHECK(scene.images[0].pixels.use_count() == 1);
+    CHECK(scene.images[0].texels.use_count() == 1);
     CHECK_THROWS_AS(MipMap<Real>(std::shared_ptr<const Image>{}), std::invalid_argument);
+}
+
+TEST_CASE_TEMPLATE("MipMap: an 8-bit image's bytes look up the bits its floats look up, on every level", Real, float, double) {
+    // An odd size (37 x 23), so that every level's box filter takes partial texels.
+    const int width = 37, height = 23;
+    const std::size_t count = std::size_t(width) * std::size_t(height);
+    auto* rgb = new std::uint8_t[3 * count];
+    Image floats(width, height);
+    std::mt19937 rng(7);
+    for (std::size_t i = 0; i < count; ++i) {
+        for (int c = 0; c < 3; ++c) rgb[3 * i + std::size_t(c)] = std::uint8_t(rng() & 0xff);
+        floats.pixels[i] = glm::vec3(float(rgb[3 * i]), float(rgb[3 * i + 1]), float(rgb[3 * i + 2]));
+    }
+    Texels::Bytes bytes{width, height, std::shared_ptr<const std::uint8_t>(rgb, [](const std::uint8_t* held) { delete[] held; })};
+    const auto from_bytes = std::make_shared<const Texels>(std::move(bytes));
+    REQUIRE(from_bytes->bytes());
+    CHECK(from_bytes->memory_bytes() == 3 * count);
+    CHECK(from_bytes->radiance()->pixels == floats.pixels);
+    const MipMap<Real> a(from_bytes), b(std::move(floats));
+    REQUIRE(a.levels() == b.levels());
+    for (int level = 1; level < a.levels(); ++level) CHECK(a.level(level).pixels == b.level(level).pixels);
+    const auto same = [](const Vec3<Real>& x, const Vec3<Real>& y) {
+        return std::bit_cast<std::array<Real, 3>>(x) == std::bit_cast<std::array<Real, 3>>(y);
+    };
+    int differing = 0;
+    for (int i = 0; i < 2000; ++i) {
+        // Coordinates beyond [0, 1) too, which repeat.
+        std::uniform_real_distribution<double> uniform(-1.0, 2.0);
+        const Vec2<Real> uv(Real(uniform(rng)), Real(uniform(rng)));
+        const Real lod = Real(uniform(rng) * 3);
+        const int level = i % a.levels();
+        if (!same(a.nearest(uv, level), b.nearest(uv, level))) ++differing;
+        if (!same(a.bilinear(uv, level), b.bilinear(uv, level))) ++differing;
+        if (!same(a.trilinear(uv, lod), b.trilinear(uv, lod))) ++differing;
+    }
+    CHECK(differing == 0);
 }
 
 TEST_CASE_TEMPLATE("MipMap: the level of detail of a ray cone", Real, float, double) {
@@ -398,7 +435,7 @@ TEST_CASE_TEMPLATE("TextureSet: replace_kd, blend_kd, replace_ks, replace_all wi
 TEST_CASE_TEMPLATE("TextureSet: degamma after normalising; HDR texels are neither normalised nor degamma'd", Real, float, double) {
     scene::Scene scene = scene_with_image_texture(grey_image(1, 1, [](int, int) { return 51; }), scene::DecalMode::replace_kd);
     scene.textures[0].degamma = true;
-    scene.images.push_back({"hdr", std::make_shared<const Image>(grey_image(1, 1, [](int, int) { return 3; })), true});
+    scene.images.push_back({"hdr", std::make_shared<const Texels>(grey_image(1, 1, [](int, int) { return 3; })), true});
     scene.textures.push_back(scene.textures[0]);
     scene.textures[1].image = 1;
     const TextureSet<Real> set(scene);
@@ -692,13 +729,15 @@ TEST_CASE("MipMap: the course's earth.jpg keeps its mean down to 1x1") {
         MESSAGE("skipped: " << earth << " is not there (course data absent)");
         return;
     }
-    const MipMap<float> map(read_image(earth));
+    const MipMap<float> map(std::make_shared<const Texels>(read_texels(earth)));
+    REQUIRE(map.base().bytes());  // a JPEG's texels stay bytes
     CHECK(map.width() == 1024);
     CHECK(map.height() == 512);
     CHECK(map.levels() == 11);  // 1024x512 ... 2x1, 1x1
     glm::dvec3 sum(0.0);
-    for (const glm::vec3& p : map.level(0).pixels) sum += glm::dvec3(p);
-    const glm::dvec3 mean = sum / double(map.level(0).pixels.size());
+    const std::shared_ptr<const Image> widened = map.base().radiance();
+    for (const glm::vec3& p : widened->pixels) sum += glm::dvec3(p);
+    const glm::dvec3 mean = sum / double(widened->pixels.size());
     CHECK(double(map.level(10)(0, 0).x) == doctest::Approx(mean.x).epsilon(1e-4));
     CHECK(double(map.level(10)(0, 0).z) == doctest::Approx(mean.z).epsilon(1e-4));
 }

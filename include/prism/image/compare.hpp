@@ -100,7 +100,10 @@ inline std::vector<std::vector<BoxTap>> box_taps(int source, int target) {
 // Resamples by area: every target pixel is the average of the source area it covers, partial
 // source pixels weighted by their covered fraction, so the image mean is preserved for any ratio
 // (5x5 -> 2x2 as well as 4x4 -> 2x2).
-inline Image downsample_box(const Image& source, int width, int height) {
+// `Source`: an Image, or anything read the same way (width, height, (x, y) -> glm::vec3), such as a
+// texture's bytes (image/texels.hpp).
+template <class Source = Image>
+Image downsample_box(const Source& source, int width, int height) {
     if (width <= 0 || height <= 0) throw std::invalid_argument("downsample_box: target size must be positive");
     if (source.width <= 0 || source.height <= 0) throw std::invalid_argument("downsample_box: empty source image");
     const auto columns = detail::box_taps(source.width, width);
@@ -113,7 +116,7 @@ inline Image downsample_box(const Image& source, int width, int height) {
             for (const auto& row : rows[std::size_t(y)])
                 for (const auto& column : columns[std::size_t(x)]) {
                     const double weight = row.weight * column.weight;
-                    const glm::vec3& pixel = source(column.source, row.source);
+                    const glm::vec3 pixel = source(column.source, row.source);
                     for (int c = 0; c < 3; ++c) sum[c] += weight * double(pixel[c]);
                     total_weight += weight;
                 }

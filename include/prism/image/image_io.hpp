@@ -6,6 +6,7 @@
 #include <prism/image/decoder_guard.hpp>
 #include <prism/image/image.hpp>
 #include <prism/image/png_encoder.hpp>
+#include <prism/image/texels.hpp>
 #include <prism/io/limits.hpp>
 #include <prism/io/load_error.hpp>
 #include <prism/parallel/for_each_run.hpp>
@@ -281,19 +282,12 @@ inline Image decode_exr(std::string_view bytes, const std::filesystem::path& pat
 
 }  // namespace detail
 
-// Decodes an image file's bytes already in memory into linear floats on the renderer's scale:
-// 8-bit formats give 0..255 (the values the course's PNGs hold), .hdr and .exr their stored
-// radiance unchanged. The extension of `path` chooses the format; `path` names the file in
-// messages. Images past io::max_image_side per side or `max_pixels` in all are refused unread.
-inline Image decode_image(std::string_view bytes, const std::filesystem::path& path,
-                          std::int64_t max_pixels = io::max_image_pixels) {
-    const std::string extension = detail::lowercase_extension(path);
-    if (extension == ".exr") return detail::decode_exr(bytes, path, max_pixels);
+namespace detail {
 
-    const bool is_hdr = extension == ".hdr";
-    const bool is_ldr = extension == ".png" || extension == ".jpg" || extension == ".jpeg" || extension == ".bmp" ||
-                        extension == ".tga" || extension == ".ppm" || extension == ".pgm";
-    if (!is_hdr && !is_ldr) throw io::LoadError(path, "", "unsupported image format '" + extension + "'");
+// An 8-bit file's bytes decoded by stb (the files of `is_ldr_extension`), after the checks every
+// such file passes first.
+inline Texels::Bytes decode_8bit(std::string_view bytes, const std::filesystem::path& path, const std::string& extension,
+                                 std::int64_t max_pixels) {
     if (!detail::has_signature_of(bytes, extension))
         throw io::LoadError(path, "", "the file's content is not the " + extension.substr(1) + " image its name says");
     if ((extension == ".jpg" || extension == ".jpeg") && !detail::jpeg_huffman_tables_fit(bytes))
@@ -305,43 +299,110 @@ inline Image decode_image(std::string_view bytes, const std::filesystem::path& p
         throw io::LoadError(path, "", "the file is larger than 2 GiB");
     const auto* memory = reinterpret_cast<const stbi_uc*>(bytes.data());
     const int length = int(bytes.size());
+    Texels::Bytes texels;
+    int channels = 0;
+    if (!stbi_info_from_memory(memory, length, &texels.width, &texels.height, &channels))
+        throw io::LoadError(path, "", "cannot read the image: " + detail::stb_failure());
+    detail::check_image_size(path, texels.width, texels.height, max_pixels);
+    // stbi_load, not stbi_loadf: stbi_loadf would undo an assumed 2.2 gamma, while the suite
+    // needs the stored byte values unchanged.
+    stbi_uc* data = stbi_load_from_memory(memory, length, &texels.width, &texels.height, &channels, 3);
+    if (!data) throw io::LoadError(path, "", "cannot read the image: " + detail::stb_failure());
+    // Copied out of stb's buffer into huge pages (memory/huge_page_allocator.hpp), in runs on
+    // TBB's threads. Lookups land anywhere in a photograph: read from stb's 4 kB pages, nearly
+    // every one missed the TLB, and MipMap::lookup took 19% of hw7 VeachAjar's profile at
+    // --scale 0.25 (perf, one thread) where from huge pages of floats it had taken under 5%.
+    const std::size_t size = 3 * std::size_t(texels.width) * std::size_t(texels.height);
+    auto storage = std::make_shared<HugePageVector<std::uint8_t>>(size);
+    for_each_run(size, 3 * image_pass_grain, [&](std::size_t first, std::size_t end) {
+        std::copy(data + first, data + end, storage->data() + first);
+    });
+    stbi_image_free(data);
+    texels.rgb = std::shared_ptr<const std::uint8_t>(storage, storage->data());
+    return texels;
+}
 
+inline bool is_ldr_extension(const std::string& extension) {
+    return extension == ".png" || extension == ".jpg" || extension == ".jpeg" || extension == ".bmp" ||
+           extension == ".tga" || extension == ".ppm" || extension == ".pgm";
+}
+
+}  // namespace detail
+
+// Decodes an image file's bytes already in memory into linear floats on the renderer's scale:
+// 8-bit formats give 0..255 (the values the course's PNGs hold), .hdr and .exr their stored
+// radiance unchanged. The extension of `path` chooses the format; `path` names the file in
+// messages. Images past io::max_image_side per side or `max_pixels` in all are refused unread.
+inline Image decode_image(std::string_view bytes, const std::filesystem::path& path,
+                          std::int64_t max_pixels = io::max_image_pixels) {
+    const std::string extension = detail::lowercase_extension(path);
+    if (extension == ".exr") return detail::decode_exr(bytes, path, max_pixels);
+    if (detail::is_ldr_extension(extension)) {
+        const Texels::Bytes texels = detail::decode_8bit(bytes, path, extension, max_pixels);
+        Image image(texels.width, texels.height, Image::Unfilled{});
+        // Converted in runs on TBB's threads: the fresh pages' first touch is most of this loop's
+        // time (the kernel zeroes each page on first touch); in runs, both threads take their
+        // share of the faults.
+        const std::uint8_t* data = texels.rgb.get();
+        for_each_run(image.pixels.size(), image_pass_grain, [&](std::size_t first, std::size_t end) {
+            for (std::size_t i = first; i < end; ++i)
+                image.pixels[i] = glm::vec3(float(data[3 * i]), float(data[3 * i + 1]), float(data[3 * i + 2]));
+        });
+        return image;
+    }
+    if (extension != ".hdr") throw io::LoadError(path, "", "unsupported image format '" + extension + "'");
+    if (!detail::has_signature_of(bytes, extension))
+        throw io::LoadError(path, "", "the file's content is not the hdr image its name says");
+    // stb takes an int length.
+    if (bytes.size() > std::size_t(std::numeric_limits<int>::max()))
+        throw io::LoadError(path, "", "the file is larger than 2 GiB");
+    const auto* memory = reinterpret_cast<const stbi_uc*>(bytes.data());
+    const int length = int(bytes.size());
     Image image;
     int channels = 0;
     if (!stbi_info_from_memory(memory, length, &image.width, &image.height, &channels))
         throw io::LoadError(path, "", "cannot read the image: " + detail::stb_failure());
     detail::check_image_size(path, image.width, image.height, max_pixels);
-    const auto copy = [&](const auto* data) {
-        if (!data) throw io::LoadError(path, "", "cannot read the image: " + detail::stb_failure());
-        // Default-initialised pixels, converted in runs on TBB's threads: the fresh pages' first
-        // touch is most of this loop's time (a texture is 15-70 MB of floats for the course's
-        // photographs, and the kernel zeroes each page on first touch); in runs, both threads
-        // take their share of the faults.
-        image.pixels.resize(std::size_t(image.width) * std::size_t(image.height));
-        for_each_run(image.pixels.size(), image_pass_grain, [&](std::size_t first, std::size_t end) {
-            for (std::size_t i = first; i < end; ++i)
-                image.pixels[i] = glm::vec3(float(data[3 * i]), float(data[3 * i + 1]), float(data[3 * i + 2]));
-        });
-        stbi_image_free(const_cast<void*>(static_cast<const void*>(data)));
-    };
-    // stbi_loadf for .hdr: linear radiance must not be squeezed to 8 bits. stbi_load, not
-    // stbi_loadf, for 8-bit files: stbi_loadf would undo an assumed 2.2 gamma, while the suite
-    // needs the stored byte values unchanged.
-    if (is_hdr) copy(stbi_loadf_from_memory(memory, length, &image.width, &image.height, &channels, 3));
-    else copy(stbi_load_from_memory(memory, length, &image.width, &image.height, &channels, 3));
+    // stbi_loadf for .hdr: linear radiance must not be squeezed to 8 bits.
+    const float* data = stbi_loadf_from_memory(memory, length, &image.width, &image.height, &channels, 3);
+    if (!data) throw io::LoadError(path, "", "cannot read the image: " + detail::stb_failure());
+    image.pixels.resize(std::size_t(image.width) * std::size_t(image.height));
+    for_each_run(image.pixels.size(), image_pass_grain, [&](std::size_t first, std::size_t end) {
+        for (std::size_t i = first; i < end; ++i) image.pixels[i] = glm::vec3(data[3 * i], data[3 * i + 1], data[3 * i + 2]);
+    });
+    stbi_image_free(const_cast<void*>(static_cast<const void*>(data)));
     return image;
 }
 
-// Reads an image file (see decode_image); only regular files are read, so a scene cannot name a
-// device or a pipe and block or exhaust the reader.
-inline Image read_image(const std::filesystem::path& path) {
+// The same file as a texture's texels (image/texels.hpp): an 8-bit file's bytes as decoded, never
+// widened to floats; .hdr and .exr as decode_image gives them. The same checks and messages.
+inline Texels decode_texels(std::string_view bytes, const std::filesystem::path& path,
+                            std::int64_t max_pixels = io::max_image_pixels) {
+    const std::string extension = detail::lowercase_extension(path);
+    if (detail::is_ldr_extension(extension)) return Texels(detail::decode_8bit(bytes, path, extension, max_pixels));
+    return Texels(decode_image(bytes, path, max_pixels));
+}
+
+namespace detail {
+// An image file's bytes; only regular files are read, so a scene cannot name a device or a pipe
+// and block or exhaust the reader.
+inline std::string read_regular_file(const std::filesystem::path& path) {
     std::error_code error;
     if (!std::filesystem::is_regular_file(path, error)) throw io::LoadError(path, "", "no such image file");
     std::ifstream stream(path, std::ios::binary);
     if (!stream) throw io::LoadError(path, "", "cannot open the image file");
-    const std::string bytes((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+    std::string bytes((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
     if (stream.bad()) throw io::LoadError(path, "", "cannot read the image file");
-    return decode_image(bytes, path);
+    return bytes;
+}
+}  // namespace detail
+
+// Reads an image file (see decode_image).
+inline Image read_image(const std::filesystem::path& path) { return decode_image(detail::read_regular_file(path), path); }
+
+// Reads a texture's image file (see decode_texels), as read_image reads one.
+inline Texels read_texels(const std::filesystem::path& path) {
+    return decode_texels(detail::read_regular_file(path), path);
 }
 
 }  // namespace prism

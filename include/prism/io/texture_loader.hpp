@@ -14,7 +14,7 @@
 // bump_normal). So such a texture becomes two scene textures, the DecalMode one and a bump_normal
 // one with BumpFactor = bumpmapMultiplier (default 1), and an object naming it gets both, in that
 // order. With DecalMode bump_normal or no DecalMode, bumpmap="true" gives the bump texture alone.
-// Images are decoded once per file (read_image: 8-bit files keep 0..255), relative to the scene's
+// Images are decoded once per file (read_texels: 8-bit files keep their bytes 0..255), relative to the scene's
 // folder. The replace_background texture, named by no object in the course's files
 // (galactica_static.xml), is the scene's background; a scene may have one.
 #pragma once
@@ -236,7 +236,7 @@ private:
         std::vector<Predecoded> results(paths.size());
         tbb::parallel_for(std::size_t(0), paths.size(), [&](std::size_t i) {
             try {
-                results[i].pixels = std::make_shared<const Image>(read_image(paths[i]));
+                results[i].texels = std::make_shared<const Texels>(read_texels(paths[i]));
             } catch (...) {
                 results[i].error = std::current_exception();
             }
@@ -257,9 +257,9 @@ private:
                 Predecoded predecoded = std::move(found->second);
                 predecoded_.erase(found);
                 if (predecoded.error) std::rethrow_exception(predecoded.error);
-                image.pixels = std::move(predecoded.pixels);
+                image.texels = std::move(predecoded.texels);
             } else {
-                image.pixels = std::make_shared<const Image>(read_image(path));
+                image.texels = std::make_shared<const Texels>(read_texels(path));
             }
         } catch (const LoadError& error) {
             throw LoadError(reader_.file(), element.where(), error.what());
@@ -279,7 +279,7 @@ private:
     // Files decode_side_by_side has decoded and decode() has not yet taken: the image or what
     // reading it threw.
     struct Predecoded {
-        std::shared_ptr<const Image> pixels;
+        std::shared_ptr<const Texels> texels;
         std::exception_ptr error;
     };
     std::map<std::filesystem::path, Predecoded> predecoded_;

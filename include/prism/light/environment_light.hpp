@@ -65,9 +65,11 @@ public:
         const std::string element = "<SphericalDirectionalLight id=\"" + light.id + "\">";
         if (light.image >= scene.images.size())
             throw io::LoadError(scene.source, element, "its image is not among the scene's images");
-        const std::shared_ptr<const Image>& pixels = scene.images[light.image].pixels;
-        if (!pixels || pixels->width <= 0 || pixels->height <= 0 ||
-            pixels->pixels.size() != std::size_t(pixels->width) * std::size_t(pixels->height))
+        const std::shared_ptr<const Texels>& texels = scene.images[light.image].texels;
+        if (!texels || texels->empty()) throw io::LoadError(scene.source, element, "its image is empty");
+        // The map's own floats (an .hdr or .exr file's are shared; an 8-bit file's widened).
+        const std::shared_ptr<const Image> pixels = texels->radiance();
+        if (pixels->pixels.size() != std::size_t(pixels->width) * std::size_t(pixels->height))
             throw io::LoadError(scene.source, element, "its image is empty");
         return EnvironmentMap<Real>(pixels, light.layout, Vec3<Real>(light.scale));
     }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <prism/image/image.hpp>
+#include <prism/image/texels.hpp>
 
 #include <glm/glm.hpp>
 
@@ -171,16 +172,17 @@ struct Material {
     std::optional<Brdf> brdf;  // none: the course's Blinn-Phong of hw1-hw5
 };
 
-// An image a texture or an environment light reads, decoded once by the loader into linear
-// float RGB as stored in the file (no normalisation: an 8-bit file keeps 0..255, an HDR file
-// its radiance), so that bad or missing files fail at load time, naming the element.
-// The decoded pixels are immutable and shared, never copied: a renderer built from the scene
-// (TextureSet's mip maps, EnvironmentLight's map) holds the same image, so a photograph is in
-// memory once (VeachAjar's three JPEGs are 118 MB of floats; copying them into the renderer
-// was 3% of its whole render's CPU), and a renderer may outlive the scene it was built from.
+// An image a texture or an environment light reads, decoded once by the loader into RGB as
+// stored in the file (no normalisation: an 8-bit file keeps its bytes 0..255, an HDR file its
+// radiance in floats; image/texels.hpp), so that bad or missing files fail at load time, naming
+// the element. The decoded texels are immutable and shared, never copied: a renderer built from
+// the scene (TextureSet's mip maps) holds the same texels, so a photograph is in memory once
+// (VeachAjar's three JPEGs are 30 MB of bytes, which as floats were 118 MB; copying them into
+// the renderer was 3% of its whole render's CPU), and a renderer may outlive the scene it was
+// built from.
 struct TextureImage {
     std::filesystem::path path;  // as resolved, for messages
-    std::shared_ptr<const Image> pixels;
+    std::shared_ptr<const Texels> texels;
     bool high_dynamic_range = false;  // .hdr / .exr
 };
 

@@ -25,6 +25,7 @@
 
 #include <prism/image/compare.hpp>
 #include <prism/image/image.hpp>
+#include <prism/image/texels.hpp>
 #include <prism/math/vector.hpp>
 #include <prism/scene/scene.hpp>
 
@@ -53,46 +54,43 @@ public:
     // box filter, so odd sizes (5x3 -> 2x1) keep the mean instead of dropping a row or column.
     // Without `pyramid` only the image itself is kept: nearest and bilinear textures never read
     // the other levels, and they cost a third more memory.
-    // Level 0 is `image` itself, shared with whoever else holds it (a scene's decoded texture:
-    // scene::TextureImage), not copied.
-    explicit MipMap(std::shared_ptr<const Image> image, bool pyramid = true) {
-        if (!image || image->width <= 0 || image->height <= 0) throw std::invalid_argument("MipMap: empty image");
-        levels_.push_back(std::move(image));
-        while (pyramid && (levels_.back()->width > 1 || levels_.back()->height > 1)) {
-            const Image& finer = *levels_.back();
-            levels_.push_back(std::make_shared<const Image>(
+    // Level 0 is `texels` itself, shared with whoever else holds it (a scene's decoded texture:
+    // scene::TextureImage), not copied; the coarser levels are floats.
+    explicit MipMap(std::shared_ptr<const Texels> texels, bool pyramid = true) : base_(std::move(texels)) {
+        if (!base_ || base_->empty()) throw std::invalid_argument("MipMap: empty image");
+        if (pyramid && (base_->width() > 1 || base_->height() > 1))
+            coarser_.push_back(base_->visit([](const auto& image) {
+                return std::make_shared<const Image>(
+                    downsample_box(image, std::max(1, image.width / 2), std::max(1, image.height / 2)));
+            }));
+        while (pyramid && !coarser_.empty() && (coarser_.back()->width > 1 || coarser_.back()->height > 1)) {
+            const Image& finer = *coarser_.back();
+            coarser_.push_back(std::make_shared<const Image>(
                 downsample_box(finer, std::max(1, finer.width / 2), std::max(1, finer.height / 2))));
         }
     }
+    explicit MipMap(std::shared_ptr<const Image> image, bool pyramid = true)
+        : MipMap(image ? std::make_shared<const Texels>(std::move(image)) : nullptr, pyramid) {}
     explicit MipMap(Image image, bool pyramid = true)
         : MipMap(std::make_shared<const Image>(std::move(image)), pyramid) {}
 
-    int levels() const { return int(levels_.size()); }
-    const Image& level(int index) const { return *levels_[std::size_t(index)]; }
-    int width() const { return levels_.front()->width; }
-    int height() const { return levels_.front()->height; }
+    int levels() const { return 1 + int(coarser_.size()); }
+    // Level 0: the image itself.
+    const Texels& base() const { return *base_; }
+    // A coarser level, 1 to levels() - 1.
+    const Image& level(int index) const { return *coarser_[std::size_t(index - 1)]; }
+    int width() const { return base_->width(); }
+    int height() const { return base_->height(); }
 
     // The texel containing (u, v) on `level`.
     Vec3<Real> nearest(const Vec2<Real>& uv, int level = 0) const {
-        const Image& image = *levels_[std::size_t(level)];
-        const int x = repeat(int(std::floor(uv.x * Real(image.width))), image.width);
-        const int y = repeat(int(std::floor(uv.y * Real(image.height))), image.height);
-        return Vec3<Real>(image(x, y));
+        return on_level(level, [&](const auto& image) { return nearest_in(image, uv); });
     }
 
     // The four texels from (floor(u W), floor(v H)) on `level`, texel i sampled at u W = i
     // (the course's convention, see the header), weighted by the distance to each.
     Vec3<Real> bilinear(const Vec2<Real>& uv, int level = 0) const {
-        const Image& image = *levels_[std::size_t(level)];
-        const Real x = uv.x * Real(image.width);
-        const Real y = uv.y * Real(image.height);
-        const Real x_floor = std::floor(x), y_floor = std::floor(y);
-        const Real fx = x - x_floor, fy = y - y_floor;
-        const int x0 = repeat(int(x_floor), image.width), x1 = repeat(x0 + 1, image.width);
-        const int y0 = repeat(int(y_floor), image.height), y1 = repeat(y0 + 1, image.height);
-        const Vec3<Real> top = (1 - fx) * Vec3<Real>(image(x0, y0)) + fx * Vec3<Real>(image(x1, y0));
-        const Vec3<Real> bottom = (1 - fx) * Vec3<Real>(image(x0, y1)) + fx * Vec3<Real>(image(x1, y1));
-        return (1 - fy) * top + fy * bottom;
+        return on_level(level, [&](const auto& image) { return bilinear_in(image, uv); });
     }
 
     // Bilinear on the two levels around `level` (0 = the image itself), blended linearly; levels
@@ -129,12 +127,39 @@ public:
     }
 
 private:
+    // `read(image)` on level `level`'s storage (the base's bytes or floats, or a coarser level).
+    template <class Read>
+    Vec3<Real> on_level(int level, Read&& read) const {
+        return level == 0 ? base_->visit(read) : read(*coarser_[std::size_t(level - 1)]);
+    }
+
+    template <class Texels2D>
+    static Vec3<Real> nearest_in(const Texels2D& image, const Vec2<Real>& uv) {
+        const int x = repeat(int(std::floor(uv.x * Real(image.width))), image.width);
+        const int y = repeat(int(std::floor(uv.y * Real(image.height))), image.height);
+        return Vec3<Real>(image(x, y));
+    }
+
+    template <class Texels2D>
+    static Vec3<Real> bilinear_in(const Texels2D& image, const Vec2<Real>& uv) {
+        const Real x = uv.x * Real(image.width);
+        const Real y = uv.y * Real(image.height);
+        const Real x_floor = std::floor(x), y_floor = std::floor(y);
+        const Real fx = x - x_floor, fy = y - y_floor;
+        const int x0 = repeat(int(x_floor), image.width), x1 = repeat(x0 + 1, image.width);
+        const int y0 = repeat(int(y_floor), image.height), y1 = repeat(y0 + 1, image.height);
+        const Vec3<Real> top = (1 - fx) * Vec3<Real>(image(x0, y0)) + fx * Vec3<Real>(image(x1, y0));
+        const Vec3<Real> bottom = (1 - fx) * Vec3<Real>(image(x0, y1)) + fx * Vec3<Real>(image(x1, y1));
+        return (1 - fy) * top + fy * bottom;
+    }
+
     static int repeat(int index, int size) {
         const int wrapped = index % size;
         return wrapped < 0 ? wrapped + size : wrapped;
     }
 
-    std::vector<std::shared_ptr<const Image>> levels_;
+    std::shared_ptr<const Texels> base_;
+    std::vector<std::shared_ptr<const Image>> coarser_;  // levels 1, 2, ...
 };
 
 }  // namespace prism

@@ -102,7 +102,7 @@ public:
                 const scene::TextureImage& image = scene.images.at(texture.image);
                 if (mipmap_of[texture.image] == unused) {
                     mipmap_of[texture.image] = mipmaps_.size();
-                    mipmaps_.emplace_back(image.pixels, pyramid[texture.image]);
+                    mipmaps_.emplace_back(image.texels, pyramid[texture.image]);
                 }
                 entry.mipmap = mipmap_of[texture.image];
                 entry.high_dynamic_range = image.high_dynamic_range;
