@@ -1,6 +1,8 @@
 // Texture lookup benchmarks (Google Benchmark): the cost of one nearest, bilinear and trilinear
 // lookup of MipMap<float> and MipMap<double> on a course texture (hw4's earth.jpg, 1024x512), at
-// the same pseudo-random (u, v) points (and, for trilinear, levels spread over the pyramid).
+// the same pseudo-random (u, v) points (and, for trilinear, levels spread over the pyramid), with
+// the texels as the renderer keeps them (the JPEG's bytes, image/texels.hpp) and as floats, side
+// by side in one run; and the cost of decoding the file each way (read_texels, read_image).
 //
 // Each benchmark sums the texels it reads and checks the sum against the same sum computed
 // once before timing (per interpolation), so the lookups cannot be optimised away and a wrong
@@ -15,6 +17,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <vector>
 
 #ifndef PRISM_SHARED_DIR
@@ -52,10 +55,12 @@ const std::vector<Query>& queries() {
     return batch;
 }
 
+// The texels as the renderer keeps them (bytes) or widened to floats.
 template <Scalar Real>
-const MipMap<Real>& earth_map() {
-    static const MipMap<Real> map(read_image(earth));
-    return map;
+const MipMap<Real>& earth_map(bool bytes) {
+    static const MipMap<Real> from_bytes(std::make_shared<const Texels>(read_texels(earth)));
+    static const MipMap<Real> from_floats(read_image(earth));
+    return bytes ? from_bytes : from_floats;
 }
 
 template <Scalar Real>
@@ -66,13 +71,18 @@ double sum_of_lookups(const MipMap<Real>& map, scene::Interpolation interpolatio
 }
 
 template <Scalar Real>
-void texture_lookup(benchmark::State& state, scene::Interpolation interpolation) {
+void texture_lookup(benchmark::State& state, scene::Interpolation interpolation, bool bytes) {
     if (!std::filesystem::exists(earth)) {
         state.SkipWithError(("course texture not found: " + earth.string()).c_str());
         return;
     }
-    const MipMap<Real>& map = earth_map<Real>();
+    const MipMap<Real>& map = earth_map<Real>(bytes);
     const double expected = sum_of_lookups(map, interpolation);
+    // Both storages read the same numbers: their sums must agree bit for bit.
+    if (expected != sum_of_lookups(earth_map<Real>(!bytes), interpolation)) {
+        state.SkipWithError("bytes and floats gave different lookups");
+        return;
+    }
     for (auto _ : state) {
         const double sum = sum_of_lookups(map, interpolation);
         benchmark::DoNotOptimize(sum);
@@ -93,29 +103,54 @@ void build_pyramid(benchmark::State& state) {
         state.SkipWithError(("course texture not found: " + earth.string()).c_str());
         return;
     }
-    const Image image = read_image(earth);
+    const auto texels = std::make_shared<const Texels>(read_texels(earth));
     for (auto _ : state) {
-        MipMap<float> map(image);
+        MipMap<float> map(texels);
         benchmark::DoNotOptimize(map.levels());
+    }
+}
+
+// Reading and decoding the file: its bytes kept (what the scene loader does) or widened to floats.
+void decode(benchmark::State& state, bool bytes) {
+    if (!std::filesystem::exists(earth)) {
+        state.SkipWithError(("course texture not found: " + earth.string()).c_str());
+        return;
+    }
+    for (auto _ : state) {
+        if (bytes) {
+            const Texels texels = read_texels(earth);
+            benchmark::DoNotOptimize(texels(texels.width() - 1, texels.height() - 1));
+        } else {
+            const Image image = read_image(earth);
+            benchmark::DoNotOptimize(image(image.width - 1, image.height - 1));
+        }
     }
 }
 
 }  // namespace
 
 // Google Benchmark's macros take a plain function name, not a template-id.
-void lookup_float(benchmark::State& state, prism::scene::Interpolation interpolation) {
-    texture_lookup<float>(state, interpolation);
+void lookup_float(benchmark::State& state, prism::scene::Interpolation interpolation, bool bytes) {
+    texture_lookup<float>(state, interpolation, bytes);
 }
-void lookup_double(benchmark::State& state, prism::scene::Interpolation interpolation) {
-    texture_lookup<double>(state, interpolation);
+void lookup_double(benchmark::State& state, prism::scene::Interpolation interpolation, bool bytes) {
+    texture_lookup<double>(state, interpolation, bytes);
 }
 
-BENCHMARK_CAPTURE(lookup_float, nearest, prism::scene::Interpolation::nearest);
-BENCHMARK_CAPTURE(lookup_float, bilinear, prism::scene::Interpolation::bilinear);
-BENCHMARK_CAPTURE(lookup_float, trilinear, prism::scene::Interpolation::trilinear);
-BENCHMARK_CAPTURE(lookup_double, nearest, prism::scene::Interpolation::nearest);
-BENCHMARK_CAPTURE(lookup_double, bilinear, prism::scene::Interpolation::bilinear);
-BENCHMARK_CAPTURE(lookup_double, trilinear, prism::scene::Interpolation::trilinear);
+BENCHMARK_CAPTURE(lookup_float, nearest_bytes, prism::scene::Interpolation::nearest, true);
+BENCHMARK_CAPTURE(lookup_float, nearest_floats, prism::scene::Interpolation::nearest, false);
+BENCHMARK_CAPTURE(lookup_float, bilinear_bytes, prism::scene::Interpolation::bilinear, true);
+BENCHMARK_CAPTURE(lookup_float, bilinear_floats, prism::scene::Interpolation::bilinear, false);
+BENCHMARK_CAPTURE(lookup_float, trilinear_bytes, prism::scene::Interpolation::trilinear, true);
+BENCHMARK_CAPTURE(lookup_float, trilinear_floats, prism::scene::Interpolation::trilinear, false);
+BENCHMARK_CAPTURE(lookup_double, nearest_bytes, prism::scene::Interpolation::nearest, true);
+BENCHMARK_CAPTURE(lookup_double, nearest_floats, prism::scene::Interpolation::nearest, false);
+BENCHMARK_CAPTURE(lookup_double, bilinear_bytes, prism::scene::Interpolation::bilinear, true);
+BENCHMARK_CAPTURE(lookup_double, bilinear_floats, prism::scene::Interpolation::bilinear, false);
+BENCHMARK_CAPTURE(lookup_double, trilinear_bytes, prism::scene::Interpolation::trilinear, true);
+BENCHMARK_CAPTURE(lookup_double, trilinear_floats, prism::scene::Interpolation::trilinear, false);
 BENCHMARK(build_pyramid)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(decode, bytes, true)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(decode, floats, false)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();
