@@ -21,6 +21,7 @@
 #include <functional>
 #include <iterator>
 #include <string>
+#include <utility>
 #include <vector>
 
 #ifndef PRISM_SOURCE_DIR
@@ -200,6 +201,8 @@ TEST_CASE("decode_image refuses an image past the size limits before decoding it
     CHECK(contains(message, "12000 x 12000"));
     // The same header under a lower cap, as the image fuzzer sets it.
     CHECK(contains(refusal([&] { prism::decode_image(signature + header, "huge.png", 1 << 16); }), "65536 in all"));
+    // A texture's decoder (bytes kept) refuses it alike.
+    CHECK(refusal([&] { prism::decode_texels(signature + header, "huge.png"); }) == message);
 }
 
 TEST_CASE("decode_image: a file's content must be the format its name says; JPEG Huffman tables fit") {
@@ -229,6 +232,24 @@ TEST_CASE("decode_image: a file's content must be the format its name says; JPEG
     CHECK(!prism::detail::pnm_header_fits("P5 1 1 # c\n 99999999999 "));
     CHECK(!prism::detail::pnm_header_fits("P5 552 2 5252\n"));  // 16-bit samples
     CHECK(contains(refusal([&] { prism::decode_image("P6 1 99999999999 255\n", "big.ppm"); }), "PNM header"));
+
+    // A texture's decoder, which keeps an 8-bit file's bytes, makes the same checks with the same
+    // messages, and refuses what decode_image refuses by format.
+    for (const auto& input : std::vector<std::pair<std::string, std::string>>{
+             {png_signature + "rest", "photo.jpg"},
+             {"GIF89a......", "photo.png"},
+             {jpeg_with_table(700), "table.jpg"},
+             {"P6 1 99999999999 255\n", "big.ppm"},
+             {"GIF89a......", "photo.gif"},
+             {"#?RADIANCE\nbroken", "sky.hdr"}}) {
+        // Not a structured binding: clang 14 cannot capture one in a lambda.
+        const std::string& bytes = input.first;
+        const std::string& name = input.second;
+        CAPTURE(name);
+        const std::string expected = refusal([&] { prism::decode_image(bytes, name); });
+        CHECK(!expected.empty());
+        CHECK(refusal([&] { prism::decode_texels(bytes, name); }) == expected);
+    }
 }
 
 // Every input a fuzzer found, replayed through the reader it broke: each must now load or be refused
@@ -249,7 +270,10 @@ TEST_CASE("the fuzzers' findings stay fixed") {
             else if (target == "ply") prism::io::parse_ply(bytes, entry.path());
             // Every image found so far is broken: refused, not decoded (a Release build would
             // not notice stb writing past its table, so the refusal itself is checked).
-            else if (target == "image") CHECK_THROWS_AS(prism::decode_image(bytes, entry.path()), LoadError);
+            else if (target == "image") {
+                CHECK_THROWS_AS(prism::decode_image(bytes, entry.path()), LoadError);
+                CHECK_THROWS_AS(prism::decode_texels(bytes, entry.path()), LoadError);
+            }
             else FAIL("unknown fuzz target folder " << target);
         } catch (const LoadError&) {
         }

@@ -26,9 +26,11 @@
 #include <iterator>
 #include <optional>
 #include <limits>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <type_traits>
 #include <vector>
 
 #include <unistd.h>
@@ -284,53 +286,63 @@ inline Image decode_exr(std::string_view bytes, const std::filesystem::path& pat
 
 namespace detail {
 
-// An 8-bit file's bytes decoded by stb (the files of `is_ldr_extension`), after the checks every
-// such file passes first.
-inline Texels::Bytes decode_8bit(std::string_view bytes, const std::filesystem::path& path, const std::string& extension,
-                                 std::int64_t max_pixels) {
-    if (!detail::has_signature_of(bytes, extension))
+inline bool is_ldr_extension(const std::string& extension) {
+    return extension == ".png" || extension == ".jpg" || extension == ".jpeg" || extension == ".bmp" ||
+           extension == ".tga" || extension == ".ppm" || extension == ".pgm";
+}
+
+// A file stb decodes (an 8-bit format or .hdr), after the checks every such file passes first:
+// its bytes as stb takes them and its size, read from its header.
+struct StbInput {
+    const stbi_uc* memory = nullptr;
+    int length = 0;
+    int width = 0, height = 0;
+};
+inline StbInput checked_stb_input(std::string_view bytes, const std::filesystem::path& path,
+                                  const std::string& extension, std::int64_t max_pixels) {
+    if (!is_ldr_extension(extension) && extension != ".hdr")
+        throw io::LoadError(path, "", "unsupported image format '" + extension + "'");
+    if (!has_signature_of(bytes, extension))
         throw io::LoadError(path, "", "the file's content is not the " + extension.substr(1) + " image its name says");
-    if ((extension == ".jpg" || extension == ".jpeg") && !detail::jpeg_huffman_tables_fit(bytes))
+    if ((extension == ".jpg" || extension == ".jpeg") && !jpeg_huffman_tables_fit(bytes))
         throw io::LoadError(path, "", "corrupt JPEG: a Huffman table of more than 256 codes");
-    if ((extension == ".ppm" || extension == ".pgm") && !detail::pnm_header_fits(bytes))
+    if ((extension == ".ppm" || extension == ".pgm") && !pnm_header_fits(bytes))
         throw io::LoadError(path, "", "unsupported PNM header: a number past 2147483647 or 16-bit samples");
     // stb takes an int length.
     if (bytes.size() > std::size_t(std::numeric_limits<int>::max()))
         throw io::LoadError(path, "", "the file is larger than 2 GiB");
-    const auto* memory = reinterpret_cast<const stbi_uc*>(bytes.data());
-    const int length = int(bytes.size());
-    Texels::Bytes texels;
+    StbInput input{reinterpret_cast<const stbi_uc*>(bytes.data()), int(bytes.size())};
     int channels = 0;
-    if (!stbi_info_from_memory(memory, length, &texels.width, &texels.height, &channels))
-        throw io::LoadError(path, "", "cannot read the image: " + detail::stb_failure());
-    detail::check_image_size(path, texels.width, texels.height, max_pixels);
-    // stbi_load, not stbi_loadf: stbi_loadf would undo an assumed 2.2 gamma, while the suite
-    // needs the stored byte values unchanged.
-    stbi_uc* data = stbi_load_from_memory(memory, length, &texels.width, &texels.height, &channels, 3);
-    if (!data) throw io::LoadError(path, "", "cannot read the image: " + detail::stb_failure());
-    // Copied out of stb's buffer into huge pages (memory/huge_page_allocator.hpp), in runs on
-    // TBB's threads. Lookups land anywhere in a photograph: read from stb's 4 kB pages, nearly
-    // every one missed the TLB, and MipMap::lookup took 19% of hw7 VeachAjar's profile at
-    // --scale 0.25 (perf, one thread) where from huge pages of floats it had taken under 5%.
-    // From half a huge page on, the array is rounded up to whole huge pages (the allocator
-    // rounds from one): hw4's earth.jpg, 1.5 MB of bytes, took 5.0-5.2 ms to read in 4 kB pages
-    // against 3.7 ms as 6 MB of floats in huge pages (prism_texture_bench, decode).
-    const std::size_t size = 3 * std::size_t(texels.width) * std::size_t(texels.height);
-    constexpr std::size_t huge_page = HugePageAllocator<std::uint8_t>::huge_page;
-    auto storage = std::make_shared<HugePageVector<std::uint8_t>>();
-    if (size >= huge_page / 2) storage->reserve((size + huge_page - 1) / huge_page * huge_page);
-    storage->resize(size);
-    for_each_run(size, 3 * image_pass_grain, [&](std::size_t first, std::size_t end) {
-        std::copy(data + first, data + end, storage->data() + first);
-    });
-    stbi_image_free(data);
-    texels.rgb = std::shared_ptr<const std::uint8_t>(storage, storage->data());
-    return texels;
+    if (!stbi_info_from_memory(input.memory, input.length, &input.width, &input.height, &channels))
+        throw io::LoadError(path, "", "cannot read the image: " + stb_failure());
+    check_image_size(path, input.width, input.height, max_pixels);
+    return input;
 }
 
-inline bool is_ldr_extension(const std::string& extension) {
-    return extension == ".png" || extension == ".jpg" || extension == ".jpeg" || extension == ".bmp" ||
-           extension == ".tga" || extension == ".ppm" || extension == ".pgm";
+// stb's decoded samples, RGB, freed by stb.
+template <class Sample>
+struct StbSamples {
+    struct Free {
+        void operator()(Sample* samples) const { stbi_image_free(samples); }
+    };
+    std::unique_ptr<Sample, Free> samples;
+    int width = 0, height = 0;
+};
+// stbi_load for 8-bit files, not stbi_loadf: stbi_loadf would undo an assumed 2.2 gamma, while
+// the suite needs the stored byte values unchanged. stbi_loadf for .hdr: linear radiance must
+// not be squeezed to 8 bits.
+template <class Sample>
+StbSamples<Sample> stb_decode(std::string_view bytes, const std::filesystem::path& path, const std::string& extension,
+                              std::int64_t max_pixels) {
+    StbInput input = checked_stb_input(bytes, path, extension, max_pixels);
+    StbSamples<Sample> decoded;
+    int channels = 0;
+    if constexpr (std::is_same_v<Sample, float>)
+        decoded.samples.reset(stbi_loadf_from_memory(input.memory, input.length, &decoded.width, &decoded.height, &channels, 3));
+    else
+        decoded.samples.reset(stbi_load_from_memory(input.memory, input.length, &decoded.width, &decoded.height, &channels, 3));
+    if (!decoded.samples) throw io::LoadError(path, "", "cannot read the image: " + stb_failure());
+    return decoded;
 }
 
 }  // namespace detail
@@ -343,41 +355,20 @@ inline Image decode_image(std::string_view bytes, const std::filesystem::path& p
                           std::int64_t max_pixels = io::max_image_pixels) {
     const std::string extension = detail::lowercase_extension(path);
     if (extension == ".exr") return detail::decode_exr(bytes, path, max_pixels);
-    if (detail::is_ldr_extension(extension)) {
-        const Texels::Bytes texels = detail::decode_8bit(bytes, path, extension, max_pixels);
-        Image image(texels.width, texels.height, Image::Unfilled{});
-        // Converted in runs on TBB's threads: the fresh pages' first touch is most of this loop's
-        // time (the kernel zeroes each page on first touch); in runs, both threads take their
-        // share of the faults.
-        const std::uint8_t* data = texels.rgb.get();
+    // Default-initialised pixels, converted in runs on TBB's threads: the fresh pages' first
+    // touch is most of this loop's time (the kernel zeroes each page on first touch); in runs,
+    // both threads take their share of the faults.
+    const auto widened = [](const auto& decoded) {
+        Image image(decoded.width, decoded.height, Image::Unfilled{});
+        const auto* data = decoded.samples.get();
         for_each_run(image.pixels.size(), image_pass_grain, [&](std::size_t first, std::size_t end) {
             for (std::size_t i = first; i < end; ++i)
                 image.pixels[i] = glm::vec3(float(data[3 * i]), float(data[3 * i + 1]), float(data[3 * i + 2]));
         });
         return image;
-    }
-    if (extension != ".hdr") throw io::LoadError(path, "", "unsupported image format '" + extension + "'");
-    if (!detail::has_signature_of(bytes, extension))
-        throw io::LoadError(path, "", "the file's content is not the hdr image its name says");
-    // stb takes an int length.
-    if (bytes.size() > std::size_t(std::numeric_limits<int>::max()))
-        throw io::LoadError(path, "", "the file is larger than 2 GiB");
-    const auto* memory = reinterpret_cast<const stbi_uc*>(bytes.data());
-    const int length = int(bytes.size());
-    Image image;
-    int channels = 0;
-    if (!stbi_info_from_memory(memory, length, &image.width, &image.height, &channels))
-        throw io::LoadError(path, "", "cannot read the image: " + detail::stb_failure());
-    detail::check_image_size(path, image.width, image.height, max_pixels);
-    // stbi_loadf for .hdr: linear radiance must not be squeezed to 8 bits.
-    const float* data = stbi_loadf_from_memory(memory, length, &image.width, &image.height, &channels, 3);
-    if (!data) throw io::LoadError(path, "", "cannot read the image: " + detail::stb_failure());
-    image.pixels.resize(std::size_t(image.width) * std::size_t(image.height));
-    for_each_run(image.pixels.size(), image_pass_grain, [&](std::size_t first, std::size_t end) {
-        for (std::size_t i = first; i < end; ++i) image.pixels[i] = glm::vec3(data[3 * i], data[3 * i + 1], data[3 * i + 2]);
-    });
-    stbi_image_free(const_cast<void*>(static_cast<const void*>(data)));
-    return image;
+    };
+    if (extension == ".hdr") return widened(detail::stb_decode<float>(bytes, path, extension, max_pixels));
+    return widened(detail::stb_decode<stbi_uc>(bytes, path, extension, max_pixels));
 }
 
 // The same file as a texture's texels (image/texels.hpp): an 8-bit file's bytes as decoded, never
@@ -385,8 +376,25 @@ inline Image decode_image(std::string_view bytes, const std::filesystem::path& p
 inline Texels decode_texels(std::string_view bytes, const std::filesystem::path& path,
                             std::int64_t max_pixels = io::max_image_pixels) {
     const std::string extension = detail::lowercase_extension(path);
-    if (detail::is_ldr_extension(extension)) return Texels(detail::decode_8bit(bytes, path, extension, max_pixels));
-    return Texels(decode_image(bytes, path, max_pixels));
+    if (!detail::is_ldr_extension(extension)) return Texels(decode_image(bytes, path, max_pixels));
+    const detail::StbSamples<stbi_uc> decoded = detail::stb_decode<stbi_uc>(bytes, path, extension, max_pixels);
+    // Copied out of stb's buffer into huge pages (memory/huge_page_allocator.hpp), in runs on
+    // TBB's threads. Lookups land anywhere in a photograph: read from stb's 4 kB pages, nearly
+    // every one missed the TLB, and MipMap::lookup took 19% of hw7 VeachAjar's profile at
+    // --scale 0.25 (perf, one thread) where from huge pages of floats it had taken under 5%.
+    // From half a huge page on, the array is rounded up to whole huge pages (the allocator
+    // rounds from one): hw4's earth.jpg, 1.5 MB of bytes, took 5.0-5.2 ms to read in 4 kB pages
+    // against 3.4-3.6 ms in a huge page (prism_texture_bench, decode).
+    const std::size_t size = 3 * std::size_t(decoded.width) * std::size_t(decoded.height);
+    constexpr std::size_t huge_page = HugePageAllocator<std::uint8_t>::huge_page;
+    auto storage = std::make_shared<HugePageVector<std::uint8_t>>();
+    if (size >= huge_page / 2) storage->reserve((size + huge_page - 1) / huge_page * huge_page);
+    storage->resize(size);
+    const stbi_uc* data = decoded.samples.get();
+    for_each_run(size, 3 * image_pass_grain, [&](std::size_t first, std::size_t end) {
+        std::copy(data + first, data + end, storage->data() + first);
+    });
+    return Texels(Texels::Bytes{decoded.width, decoded.height, std::shared_ptr<const std::uint8_t>(storage, storage->data())});
 }
 
 namespace detail {
