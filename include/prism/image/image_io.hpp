@@ -291,12 +291,11 @@ inline bool is_ldr_extension(const std::string& extension) {
            extension == ".tga" || extension == ".ppm" || extension == ".pgm";
 }
 
-// A file stb decodes (an 8-bit format or .hdr), after the checks every such file passes first:
-// its bytes as stb takes them and its size, read from its header.
+// A file stb decodes (an 8-bit format or .hdr), after the checks every such file passes first
+// (its size among them, read from its header): its bytes as stb takes them.
 struct StbInput {
     const stbi_uc* memory = nullptr;
     int length = 0;
-    int width = 0, height = 0;
 };
 inline StbInput checked_stb_input(std::string_view bytes, const std::filesystem::path& path,
                                   const std::string& extension, std::int64_t max_pixels) {
@@ -312,10 +311,10 @@ inline StbInput checked_stb_input(std::string_view bytes, const std::filesystem:
     if (bytes.size() > std::size_t(std::numeric_limits<int>::max()))
         throw io::LoadError(path, "", "the file is larger than 2 GiB");
     StbInput input{reinterpret_cast<const stbi_uc*>(bytes.data()), int(bytes.size())};
-    int channels = 0;
-    if (!stbi_info_from_memory(input.memory, input.length, &input.width, &input.height, &channels))
+    int width = 0, height = 0, channels = 0;
+    if (!stbi_info_from_memory(input.memory, input.length, &width, &height, &channels))
         throw io::LoadError(path, "", "cannot read the image: " + stb_failure());
-    check_image_size(path, input.width, input.height, max_pixels);
+    check_image_size(path, width, height, max_pixels);
     return input;
 }
 
@@ -334,7 +333,7 @@ struct StbSamples {
 template <class Sample>
 StbSamples<Sample> stb_decode(std::string_view bytes, const std::filesystem::path& path, const std::string& extension,
                               std::int64_t max_pixels) {
-    StbInput input = checked_stb_input(bytes, path, extension, max_pixels);
+    const StbInput input = checked_stb_input(bytes, path, extension, max_pixels);
     StbSamples<Sample> decoded;
     int channels = 0;
     if constexpr (std::is_same_v<Sample, float>)

@@ -58,16 +58,12 @@ public:
     // scene::TextureImage), not copied; the coarser levels are floats.
     explicit MipMap(std::shared_ptr<const Texels> texels, bool pyramid = true) : base_(std::move(texels)) {
         if (!base_ || base_->empty()) throw std::invalid_argument("MipMap: empty image");
-        if (pyramid && (base_->width() > 1 || base_->height() > 1))
-            coarser_.push_back(base_->visit([](const auto& image) {
+        const auto above_one_texel = [](const auto& level) { return level.width > 1 || level.height > 1; };
+        while (pyramid && on_level(levels() - 1, above_one_texel))
+            coarser_.push_back(on_level(levels() - 1, [](const auto& finer) {
                 return std::make_shared<const Image>(
-                    downsample_box(image, std::max(1, image.width / 2), std::max(1, image.height / 2)));
+                    downsample_box(finer, std::max(1, finer.width / 2), std::max(1, finer.height / 2)));
             }));
-        while (pyramid && !coarser_.empty() && (coarser_.back()->width > 1 || coarser_.back()->height > 1)) {
-            const Image& finer = *coarser_.back();
-            coarser_.push_back(std::make_shared<const Image>(
-                downsample_box(finer, std::max(1, finer.width / 2), std::max(1, finer.height / 2))));
-        }
     }
     explicit MipMap(std::shared_ptr<const Image> image, bool pyramid = true)
         : MipMap(image ? std::make_shared<const Texels>(std::move(image)) : nullptr, pyramid) {}
@@ -129,7 +125,7 @@ public:
 private:
     // `read(image)` on level `level`'s storage (the base's bytes or floats, or a coarser level).
     template <class Read>
-    Vec3<Real> on_level(int level, Read&& read) const {
+    decltype(auto) on_level(int level, Read&& read) const {
         return level == 0 ? base_->visit(read) : read(*coarser_[std::size_t(level - 1)]);
     }
 
