@@ -106,15 +106,11 @@ public:
         std::uint32_t found = 0;
         for (std::uint32_t lanes = batch.active; lanes != 0; lanes &= lanes - 1) {
             const int i = std::countr_zero(lanes);
-            bool hit = false;
-            switch (batch.culling) {
-                case BackfaceCulling::none: hit = closest_one<BackfaceCulling::none>(batch.rays[i], hits[i]); break;
-                case BackfaceCulling::triangles:
-                    hit = closest_one<BackfaceCulling::triangles>(batch.rays[i], hits[i]);
-                    break;
-                case BackfaceCulling::all: hit = closest_one<BackfaceCulling::all>(batch.rays[i], hits[i]); break;
-            }
-            if (hit) found |= std::uint32_t(1) << i;
+            // Triangles cull under both rules that cull; planes only under `all` (as SceneIndex).
+            const bool hit = culls_back_faces(batch.culling) ? closest_one<true>(batch.rays[i], hits[i])
+                                                             : closest_one<false>(batch.rays[i], hits[i]);
+            if (planes_.closest(batch.rays[i], hits[i], batch.culling == BackfaceCulling::all) || hit)
+                found |= std::uint32_t(1) << i;
         }
         return found;
     }
@@ -132,15 +128,16 @@ public:
     std::int64_t embree_bytes() const { return device_.bytes(); }
 
 private:
-    // Closest hit in (ray.t_min, ray.t_max]; on a hit, ray.t_max becomes the hit distance.
-    template <BackfaceCulling Culling>
+    // Closest hit in (ray.t_min, ray.t_max] among every surface but the planes; on a hit,
+    // ray.t_max becomes the hit distance. Cull: back-facing triangles are skipped.
+    template <bool Cull>
     bool closest_one(Ray<Real>& ray, Hit<Real>& hit) const {
         RTCRayHit ray_hit;
         ray_hit.ray = embree_ray(ray, ray.t_max);
         ray_hit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         ray_hit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         Context context(this, ray);
-        context.base.filter = filter_for<Culling, false>();
+        context.base.filter = filter_for<Cull, false>();
         rtcIntersect1(scene_.get(), &context.base, &ray_hit);
         bool found = false;
         if (ray_hit.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
@@ -154,7 +151,7 @@ private:
             ray.t_max = hit.t;
             found = true;
         }
-        return planes_.template closest<Culling>(ray, hit) || found;
+        return found;
     }
 
     // Whether anything lies in (ray.t_min, ray.t_max): open at t_max, like prism's own.
@@ -166,7 +163,7 @@ private:
             embree.tfar = std::nextafter(embree.tfar, exact_filter ? std::numeric_limits<float>::infinity()
                                                                    : -std::numeric_limits<float>::infinity());
         Context context(this, ray);
-        context.base.filter = filter_for<BackfaceCulling::none, true>();
+        context.base.filter = filter_for<false, true>();
         rtcOccluded1(scene_.get(), &context.base, &embree);
         return embree.tfar == -std::numeric_limits<float>::infinity() || planes_.occludes(ray);
     }
@@ -353,13 +350,13 @@ private:
 
     // The context filter of a query: culling (camera rays, geometry/backface_culling.hpp), then
     // in double prism's test; none when neither applies.
-    template <BackfaceCulling Culling, bool AnyHit>
+    template <bool Cull, bool AnyHit>
     static RTCFilterFunctionN filter_for() {
-        if constexpr (Culling != BackfaceCulling::none || exact_filter) return &filter<Culling, AnyHit>;
+        if constexpr (Cull || exact_filter) return &filter<Cull, AnyHit>;
         else return nullptr;
     }
 
-    template <BackfaceCulling Culling, bool AnyHit>
+    template <bool Cull, bool AnyHit>
     static void filter(const RTCFilterFunctionNArguments* args) {
         if (!args->valid[0]) return;
         const auto* context = reinterpret_cast<const Context*>(args->context);
@@ -367,11 +364,11 @@ private:
         const std::uint32_t object =
             instance != RTC_INVALID_GEOMETRY_ID ? instance : RTCHitN_geomID(args->hit, args->N, 0);
         const std::uint32_t primitive = RTCHitN_primID(args->hit, args->N, 0);
-        if constexpr (Culling != BackfaceCulling::none) {
+        if constexpr (Cull) {
             // prism's own orientation test, on prism's triangle and ray: with Embree's rounded
             // normal and ray, grazing triangles (hw1 rt_raven's) came out on the other side
             // (81.8 -> 72.7 dB).
-            if (context->self->culled(object, primitive, *context->world_ray, Culling)) {
+            if (context->self->culled(object, primitive, *context->world_ray)) {
                 args->valid[0] = 0;
                 return;
             }

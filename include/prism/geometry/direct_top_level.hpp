@@ -12,7 +12,6 @@
 
 #include <prism/math/force_inline.hpp>
 #include <prism/geometry/aabb.hpp>
-#include <prism/geometry/backface_culling.hpp>
 #include <prism/geometry/hit.hpp>
 #include <prism/geometry/placement.hpp>
 #include <prism/geometry/sphere.hpp>
@@ -133,7 +132,7 @@ public:
 
     // The closest hit among the objects, in their order (spheres, then meshes), below ray.t_max
     // (lowered to it, hit filled); `found`: something nearer was hit already.
-    template <BackfaceCulling Culling>
+    template <bool Cull>
     PRISM_FORCE_INLINE bool closest(Ray<Real>& ray, Hit<Real>& hit, bool found) const {
         const Candidates may = candidates(ray);
         for (std::uint32_t lanes = may.spheres; lanes != 0; lanes &= lanes - 1) {
@@ -153,7 +152,7 @@ public:
                 const std::optional<Ray<Real>> local = mesh_ray(direct, ray);
                 if (!local) continue;
                 const typename Mesh::TriangleRay triangle_ray(*local);
-                if (culls_back_faces(Culling) ? direct.mesh->template intersect_leaf<true>(*local, triangle_ray, direct.leaf, ray.t_max, hit)
+                if (Cull ? direct.mesh->template intersect_leaf<true>(*local, triangle_ray, direct.leaf, ray.t_max, hit)
                                               : direct.mesh->template intersect_leaf<false>(*local, triangle_ray, direct.leaf, ray.t_max, hit)) {
                     hit.object = direct.object;
                     found = true;

@@ -4,7 +4,6 @@
 #pragma once
 
 #include <prism/math/force_inline.hpp>
-#include <prism/geometry/backface_culling.hpp>
 #include <prism/geometry/hit.hpp>
 #include <prism/geometry/ray.hpp>
 #include <prism/geometry/surface_error.hpp>
@@ -84,9 +83,8 @@ public:
 
     // The closest plane in (ray.t_min, ray.t_max] (ray.t_max lowered to it, hit filled): the
     // lanes are accepted in order as one plane after another would be, so the hit is the
-    // scalar loop's. Culling all: planes met from behind are skipped.
-    template <BackfaceCulling Culling = BackfaceCulling::none>
-    bool closest(Ray<Real>& ray, Hit<Real>& hit) const {
+    // scalar loop's. cull_back_faces (BackfaceCulling::all): planes met from behind are skipped.
+    bool closest(Ray<Real>& ray, Hit<Real>& hit, bool cull_back_faces = false) const {
         bool found = false;
         for (std::size_t b = 0; b < blocks_.size(); ++b) {
             alignas(64) Real t[width];
@@ -94,9 +92,7 @@ public:
             for (std::uint32_t lanes = distances(blocks_[b], ray, t, denominator); lanes != 0; lanes &= lanes - 1) {
                 const int lane = std::countr_zero(lanes);
                 if (!(t[lane] <= ray.t_max)) continue;
-                if constexpr (Culling == BackfaceCulling::all) {
-                    if (denominator[lane] > 0) continue;
-                }
+                if (cull_back_faces && denominator[lane] > 0) continue;
                 ray.t_max = t[lane];
                 hit = Hit<Real>{t[lane], first_object_ + std::uint32_t(b * width + std::size_t(lane)), 0, 0, 0};
                 found = true;

@@ -144,15 +144,18 @@ public:
     // which leaves are visited only when two candidates tie, and a ray whose hit in a lane
     // traversal came at exactly the t_max it was given is traced again on its own.
     // A batch of one is inlined into the caller down to closest_one's dispatch.
+    // Every route below tests every surface but the planes; the entry tests the planes last,
+    // from the t_max the route leaves (where each route had tested them, so the same hits).
+    // Only BackfaceCulling::all culls planes, and triangles cull under both rules that cull:
+    // so the routes are compiled for two rules (Cull: the triangles' rule) and the planes
+    // take theirs at run time. Compiled for all three, the third copy of every route was a
+    // tenth of the prism binary's code, and of a consumer's compile.
     PRISM_FORCE_INLINE std::uint32_t intersect(const RayBatch<Real>& batch, Hit<Real>* hits) const {
         if (batch.count == 1) {
             if (!(batch.active & 1)) return 0;
-            switch (batch.culling) {
-                case BackfaceCulling::none: break;
-                case BackfaceCulling::triangles: return closest_one<BackfaceCulling::triangles>(batch.rays[0], hits[0]);
-                case BackfaceCulling::all: return closest_one<BackfaceCulling::all>(batch.rays[0], hits[0]);
-            }
-            return closest_one<BackfaceCulling::none>(batch.rays[0], hits[0]);
+            Ray<Real>& ray = batch.rays[0];
+            const bool found = culls_back_faces(batch.culling) ? closest_one<true>(ray, hits[0]) : closest_one<false>(ray, hits[0]);
+            return planes_.closest(ray, hits[0], batch.culling == BackfaceCulling::all) || found;
         }
         return closest_many(batch, hits);
     }
@@ -186,47 +189,50 @@ public:
 
 
 private:
-    // One ray's closest hit. The small scenes' direct form is a dispatch to two out-of-line
-    // functions, and is inlined into the caller; the indexed form stays one out-of-line
-    // function. GCC weighed the two as one: once the kernel's slab test changed size it stopped
+    // One ray's closest hit among every surface but the planes. The small scenes' direct form
+    // is a dispatch to two out-of-line functions, and is inlined into the caller; the indexed
+    // form stays one out-of-line function. GCC weighed the two as one: once the kernel's slab test changed size it stopped
     // inlining the whole, and every camera ray of the sphere scenes paid a call and its spills
     // (3% of hw1 simple_shading's CPU time, 8-13% of hw1 two_spheres').
-    template <BackfaceCulling Culling>
+    template <bool Cull>
     PRISM_FORCE_INLINE bool closest_one(Ray<Real>& ray, Hit<Real>& hit) const {
         if (direct_form_) {
-            const bool found = !world_meshes_.empty() && (several_leaves_ ? intersect_world_leaves<Culling, true>(ray, hit)
-                                                                       : intersect_world_leaves<Culling, false>(ray, hit));
-            return closest_direct<Culling>(ray, hit, found);
+            const bool found = !world_meshes_.empty() && (several_leaves_ ? intersect_world_leaves<Cull, true>(ray, hit)
+                                                                       : intersect_world_leaves<Cull, false>(ray, hit));
+            return direct_.template closest<Cull>(ray, hit, found);
         }
-        return intersect_indexed<Culling>(ray, hit);
+        return intersect_indexed<Cull>(ray, hit);
     }
 
     // A batch of several rays, traversed as route() says: side by side, the active rays first
     // gathered to the front if the mask has gaps (closest_dense), or ray by ray.
     std::uint32_t closest_many(const RayBatch<Real>& batch, Hit<Real>* hits) const {
-        switch (batch.culling) {
-            case BackfaceCulling::none: break;
-            case BackfaceCulling::triangles: return closest_gathered<BackfaceCulling::triangles>(batch, hits);
-            case BackfaceCulling::all: return closest_gathered<BackfaceCulling::all>(batch, hits);
+        std::uint32_t found = culls_back_faces(batch.culling) ? closest_gathered<true>(batch, hits)
+                                                              : closest_gathered<false>(batch, hits);
+        if (planes_.empty()) return found;
+        const bool cull_planes = batch.culling == BackfaceCulling::all;
+        for (std::uint32_t lanes = batch.active; lanes != 0; lanes &= lanes - 1) {
+            const int i = std::countr_zero(lanes);
+            if (planes_.closest(batch.rays[i], hits[i], cull_planes)) found |= std::uint32_t(1) << i;
         }
-        return closest_gathered<BackfaceCulling::none>(batch, hits);
+        return found;
     }
-    template <BackfaceCulling Culling>
+    template <bool Cull>
     std::uint32_t closest_gathered(const RayBatch<Real>& batch, Hit<Real>* hits) const {
         const BatchRoute way = route(std::popcount(batch.active));
         if (way == BatchRoute::ray_by_ray) {
             std::uint32_t found = 0;
             for (std::uint32_t lanes = batch.active; lanes != 0; lanes &= lanes - 1) {
                 const int i = std::countr_zero(lanes);
-                if (closest_one<Culling>(batch.rays[i], hits[i])) found |= std::uint32_t(1) << i;
+                if (closest_one<Cull>(batch.rays[i], hits[i])) found |= std::uint32_t(1) << i;
             }
             return found;
         }
-        if (batch.dense()) return closest_dense<Culling>(way, batch.rays, hits, batch.count);
+        if (batch.dense()) return closest_dense<Cull>(way, batch.rays, hits, batch.count);
         Gathered gathered(batch);
         Hit<Real> gathered_hits[RayBatch<Real>::max_rays];
         for (int k = 0; k < gathered.count; ++k) gathered_hits[k] = hits[gathered.index[k]];
-        const std::uint32_t found = closest_dense<Culling>(way, gathered.rays, gathered_hits, gathered.count);
+        const std::uint32_t found = closest_dense<Cull>(way, gathered.rays, gathered_hits, gathered.count);
         for (int k = 0; k < gathered.count; ++k) {
             batch.rays[gathered.index[k]].t_max = gathered.rays[k].t_max;
             hits[gathered.index[k]] = gathered_hits[k];
@@ -275,7 +281,7 @@ private:
     };
 
     // intersect through the top-level index (scenes that chose no direct form).
-    template <BackfaceCulling Culling>
+    template <bool Cull>
     bool intersect_indexed(Ray<Real>& ray, Hit<Real>& hit) const {
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;  // made when the ray first enters a mesh
@@ -285,7 +291,7 @@ private:
         std::optional<RayBoxPrecomputed<Real>> box_ray;  // made once, for the first group's box
         for (const WorldMeshes& group : world_meshes_) {
             const Mesh& index = index_of(group);
-            const bool cull = culls_back_faces(Culling);
+            const bool cull = Cull;
             bool group_hit = false;
             if (group.leaves) {
                 if constexpr (Mesh::packed) {
@@ -304,7 +310,7 @@ private:
                 found = true;
             }
         }
-        return intersect_top<Culling>(ray, hit, found, traversal_ray, world_triangle_ray);
+        return intersect_top<Cull>(ray, hit, found, traversal_ray, world_triangle_ray);
     }
 
     // occluded_one in a scene with an index (no direct form).
@@ -349,13 +355,13 @@ private:
 
     // Batches side by side (geometry/scene_index_lanes.hpp).
     static constexpr int index_lanes = 16;
-    template <BackfaceCulling Culling>
+    template <bool Cull>
     std::uint32_t closest_dense(BatchRoute way, Ray<Real>* rays, Hit<Real>* hits, int count) const;
     std::uint32_t occluded_dense(BatchRoute way, const Ray<Real>* rays, int count) const;
-    template <BackfaceCulling Culling>
+    template <bool Cull>
     std::uint32_t intersect_through_index(Ray<Real>* rays, Hit<Real>* hits, int count) const
         requires Mesh::packed;
-    template <BackfaceCulling Culling>
+    template <bool Cull>
     std::uint32_t intersect_in_object_space(const Placement<Real>& instance, const Ray<Real>* rays, const Real* t_min,
                                             Real* t_max, std::uint32_t lanes, Hit<Real>* hits, std::uint32_t& tied) const
         requires Mesh::packed;
@@ -406,19 +412,19 @@ private:
         return merged;
     }
 
-    // intersect_indexed past the world meshes: the top level (direct or through its index),
-    // then the planes; `found` whether the world meshes were hit.
-    template <BackfaceCulling Culling>
+    // intersect_indexed past the world meshes: the top level (direct or through its index);
+    // `found` whether the world meshes were hit.
+    template <bool Cull>
     PRISM_FORCE_INLINE bool intersect_top(Ray<Real>& ray, Hit<Real>& hit, bool found, const TraversalRay& traversal_ray,
                                               std::optional<TriangleRay>& world_triangle_ray) const {
-        if (direct_.chosen()) return closest_direct<Culling>(ray, hit, found);
-        if (top_objects_.empty()) return planes_.template closest<Culling>(ray, hit) || found;
+        if (direct_.chosen()) return direct_.template closest<Cull>(ray, hit, found);
+        if (top_objects_.empty()) return found;
         const auto& order = top_.primitive_indices();
         top_.traverse_closest(traversal_ray, ray.t_min, ray.t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_max) {
             bool leaf_hit = false;
             for (std::uint32_t i = first; i < first + count; ++i) {
                 const std::uint32_t object = top_objects_[order[i]];
-                if (intersect_instance<Culling>(placements_[object], ray, traversal_ray, world_triangle_ray, t_max, hit)) {
+                if (intersect_instance<Cull>(placements_[object], ray, traversal_ray, world_triangle_ray, t_max, hit)) {
                     hit.object = object;
                     leaf_hit = true;
                 }
@@ -426,14 +432,7 @@ private:
             found |= leaf_hit;
             return leaf_hit;
         });
-        return planes_.template closest<Culling>(ray, hit) || found;
-    }
-
-    // The direct top level's closest hit, then the planes'; `found`: something nearer was hit.
-    template <BackfaceCulling Culling>
-    PRISM_FORCE_INLINE bool closest_direct(Ray<Real>& ray, Hit<Real>& hit, bool found) const {
-        found = direct_.template closest<Culling>(ray, hit, found);
-        return planes_.template closest<Culling>(ray, hit) || found;
+        return found;
     }
     PRISM_FORCE_INLINE bool occluded_direct(const Ray<Real>& ray) const {
         return direct_.occludes(ray) || planes_.occludes(ray);
@@ -457,14 +456,14 @@ private:
 
     // Forced inline, as occludes below: the top level's leaf callbacks call them for every
     // object they reach, and with to_object forced inline GCC put both out of line (nm).
-    template <BackfaceCulling Culling>
+    template <bool Cull>
     PRISM_FORCE_INLINE bool intersect_instance(const Placement<Real>& instance, const Ray<Real>& ray,
                                                    const TraversalRay& traversal_ray,
                                                    std::optional<TriangleRay>& world_triangle_ray, Real& t_max,
                                                    Hit<Real>& hit) const {
         if (instance.kind == Kind::mesh) {
             const auto& mesh = mesh_at(instance.shape);
-            const bool cull = culls_back_faces(Culling);
+            const bool cull = Cull;
             if (instance.template in_world_space<MotionBlur>()) {
                 if (!world_triangle_ray) world_triangle_ray.emplace(ray);
                 return cull ? mesh.template intersect<true>(ray, traversal_ray, *world_triangle_ray, t_max, hit)
@@ -528,14 +527,14 @@ private:
     // The world-space meshes' leaves for intersect's direct path: hit or not, and hit filled as
     // intersect's loop over the indices fills it.
     // Several: some index has more than one (several_leaves_); without, the one-leaf code alone.
-    template <BackfaceCulling Culling, bool Several>
+    template <bool Cull, bool Several>
     bool intersect_world_leaves(Ray<Real>& ray, Hit<Real>& hit) const {
         if constexpr (Mesh::packed) {
             std::optional<TriangleRay> triangle_ray;  // made for the first leaf the ray may reach
             bool found = false;
             for (const WorldMeshes& group : world_meshes_) {
                 const Mesh& index = index_of(group);
-                const bool cull = culls_back_faces(Culling);
+                const bool cull = Cull;
                 const bool group_hit = cull ? intersect_root_leaves<true, Several>(index, *group.leaves, ray, triangle_ray, hit)
                                             : intersect_root_leaves<false, Several>(index, *group.leaves, ray, triangle_ray, hit);
                 if (group_hit) {

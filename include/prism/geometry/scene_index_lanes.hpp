@@ -84,23 +84,24 @@ inline typename Packets::LanePack SceneIndex<Real, Policy, MotionBlur>::lanes_t_
     return Packets::LanePack::load(limits);
 }
 
-// The closest hits of rays[0, count) side by side, each as closest_one gives it alone: its
+// The closest hits of rays[0, count) side by side (every surface but the planes, which the
+// entry tests last), each as closest_one gives it alone: its
 // ray.t_max lowered to the hit and hits[i] filled, bit i of the answer set, where it hits
 // (count <= 32). BatchRoute::leaf_lanes: the world meshes' leaves are tested against several
 // rays at once (TriangleMesh::intersect_leaf_lanes, lane by lane the leaf test's bits),
 // leaf after leaf of the root, then the direct spheres likewise
-// (intersect_direct_spheres_lanes), each ray then the planes on its own; a ray whose hits in
+// (intersect_direct_spheres_lanes); a ray whose hits in
 // two leaves tie is traced again alone (closest_one), as intersect_root_leaves does.
 // BatchRoute::index_lanes: the rays traverse the index together (intersect_through_index).
 template <Scalar Real, class Policy, bool MotionBlur>
     requires AccelerationPolicy<Policy, Real>
-template <BackfaceCulling Culling>
+template <bool Cull>
 std::uint32_t SceneIndex<Real, Policy, MotionBlur>::closest_dense(BatchRoute way, Ray<Real>* rays, Hit<Real>* hits, int count) const {
     std::uint32_t found = 0;
     if (way == BatchRoute::index_lanes) {
         if constexpr (Mesh::packed) {
             for (int first = 0; first < count; first += index_lanes)
-                found |= intersect_through_index<Culling>(rays + first, hits + first, std::min(index_lanes, count - first))
+                found |= intersect_through_index<Cull>(rays + first, hits + first, std::min(index_lanes, count - first))
                          << first;
         }
         return found;
@@ -133,7 +134,7 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::closest_dense(BatchRoute way
                         if (lanes == 0) continue;
                         if (!lanes_ray) lanes_ray.emplace(group, n);
                         lane_hits.found = 0;
-                        if (culls_back_faces(Culling))
+                        if (Cull)
                             index.template intersect_leaf_lanes<true>(*lanes_ray, leaf, lanes, lane_hits);
                         else
                             index.template intersect_leaf_lanes<false>(*lanes_ray, leaf, lanes, lane_hits);
@@ -170,17 +171,12 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::closest_dense(BatchRoute way
                 }
                 static_assert(width <= Direct::width, "a group of rays fits the direct lanes");
                 if (direct_.has_spheres()) direct_.intersect_spheres_lanes(group, group_hits, n, world_hits);
-                // No direct meshes (intersection_batches): the planes, ray by ray, where there are any.
-                if (!planes_.empty())
-                    for (int i = 0; i < n; ++i)
-                        if (!((tied >> i) & 1) && planes_.template closest<Culling>(group[i], group_hits[i]))
-                            world_hits |= std::uint32_t(1) << i;
                 // The tied rays (an edge shared by two leaves), each traced again alone.
                 for (; tied != 0; tied &= tied - 1) {
                     const int i = std::countr_zero(tied);
                     group[i].t_max = given_t_max[i];
                     group_hits[i] = given_hits[i];
-                    if (!closest_one<Culling>(group[i], group_hits[i])) world_hits &= ~(std::uint32_t(1) << i);
+                    if (!closest_one<Cull>(group[i], group_hits[i])) world_hits &= ~(std::uint32_t(1) << i);
                 }
                 found |= world_hits << first;
             }
@@ -245,14 +241,14 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::occluded_dense(BatchRoute wa
 // closest_dense in a scene traversed through its index (no direct form), for up to
 // index_lanes rays: each world mesh's closest hits for the rays together
 // (TriangleMesh::intersect_lanes: each ray set up and tested as intersect_indexed sets it up
-// and tests it, the leaves visited in one order for all), then each ray's top level and
-// planes on its own (intersect_top). A pixel's camera rays reach the same nodes, whose
+// and tests it, the leaves visited in one order for all), then each ray's top level on its
+// own (intersect_top). A pixel's camera rays reach the same nodes, whose
 // tests then overlap instead of each waiting on the one before. A ray whose hit in a mesh
 // may depend on that order (a tie) is traced through that mesh again on its own, from
 // where it was before the mesh, so every ray's hit is intersect's.
 template <Scalar Real, class Policy, bool MotionBlur>
     requires AccelerationPolicy<Policy, Real>
-template <BackfaceCulling Culling>
+template <bool Cull>
 std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_through_index(Ray<Real>* rays, Hit<Real>* hits, int count) const
     requires Mesh::packed
 {
@@ -264,7 +260,7 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_through_index(Ray<
     std::uint32_t found = 0;
     for (const WorldMeshes& group : world_meshes_) {
         const Mesh& index = index_of(group);
-        const bool cull = culls_back_faces(Culling);
+        const bool cull = Cull;
         std::uint32_t lanes = 0;
         for (std::uint32_t rest = present; rest != 0; rest &= rest - 1) {
             const int i = std::countr_zero(rest);
@@ -313,7 +309,7 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_through_index(Ray<
             // Made again where a top-level mesh in world space needs it (its set-up is the
             // ray's alone, so the same bits).
             std::optional<TriangleRay> world_triangle_ray;
-            if (intersect_top<Culling>(rays[i], hits[i], (found >> i) & 1, traversal[std::size_t(i)], world_triangle_ray))
+            if (intersect_top<Cull>(rays[i], hits[i], (found >> i) & 1, traversal[std::size_t(i)], world_triangle_ray))
                 answer |= std::uint32_t(1) << i;
         }
         return answer;
@@ -338,13 +334,13 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_through_index(Ray<
                 if (instance.kind == Kind::mesh && instance.template in_world_space<MotionBlur>()) {
                     const TriangleRay* const world_triangle = world.triangles(testing);
                     const Mesh& mesh = mesh_at(instance.shape);
-                    instance_hits = culls_back_faces(Culling)
+                    instance_hits = Cull
                                         ? mesh.template intersect_lanes<true>(rays, traversal.data(), world_triangle, t_min,
                                                                               t_max, testing, hits, tied)
                                         : mesh.template intersect_lanes<false>(rays, traversal.data(), world_triangle, t_min,
                                                                                t_max, testing, hits, tied);
                 } else {
-                    instance_hits = intersect_in_object_space<Culling>(instance, rays, t_min, t_max, testing, hits, tied);
+                    instance_hits = intersect_in_object_space<Cull>(instance, rays, t_min, t_max, testing, hits, tied);
                 }
                 for (std::uint32_t rest = instance_hits; rest != 0; rest &= rest - 1)
                     hits[std::countr_zero(rest)].object = object;
@@ -361,13 +357,13 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_through_index(Ray<
             hits[i] = hit_before[std::size_t(i)];
             rays[i].t_max = t_max[i];
             std::optional<TriangleRay> world_triangle_ray;
-            if (intersect_top<Culling>(rays[i], hits[i], (world_found & bit) != 0, traversal[std::size_t(i)],
+            if (intersect_top<Cull>(rays[i], hits[i], (world_found & bit) != 0, traversal[std::size_t(i)],
                                        world_triangle_ray))
                 answer |= bit;
             continue;
         }
         rays[i].t_max = t_max[i];
-        if (planes_.template closest<Culling>(rays[i], hits[i]) || (found & bit)) answer |= bit;
+        answer |= found & bit;
     }
     return answer;
 }
@@ -377,7 +373,7 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_through_index(Ray<
 // TriangleMesh::intersect_lanes sets it (a sphere's hit at the t_max it was given, too).
 template <Scalar Real, class Policy, bool MotionBlur>
     requires AccelerationPolicy<Policy, Real>
-template <BackfaceCulling Culling>
+template <bool Cull>
 std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_in_object_space(const Placement<Real>& instance, const Ray<Real>* rays, const Real* t_min, Real* t_max,
                                         std::uint32_t lanes, Hit<Real>* hits, std::uint32_t& tied) const
     requires Mesh::packed
@@ -400,7 +396,7 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_in_object_space(co
     ObjectSpaceRays local;
     local.make(instance, rays, lanes);
     const Mesh& mesh = mesh_at(instance.shape);
-    return culls_back_faces(Culling)
+    return Cull
                ? mesh.template intersect_lanes<true>(local.ray.data(), local.traversal.data(), local.triangle.data(),
                                                      t_min, t_max, lanes, hits, tied)
                : mesh.template intersect_lanes<false>(local.ray.data(), local.traversal.data(), local.triangle.data(),

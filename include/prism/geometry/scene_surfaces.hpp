@@ -8,7 +8,6 @@
 #pragma once
 
 #include <prism/math/force_inline.hpp>
-#include <prism/geometry/backface_culling.hpp>
 #include <prism/geometry/hit.hpp>
 #include <prism/geometry/mesh_surface.hpp>
 #include <prism/geometry/placement.hpp>
@@ -169,11 +168,12 @@ public:
         if (found) hit.object = object;
         return found;
     }
-    // Whether `culling` skips this triangle of this object for this (world-space) ray, decided
-    // as prism's own index decides it: meshes by their winding in object space.
-    bool culled(std::uint32_t object, std::uint32_t primitive, const Ray<Real>& ray, BackfaceCulling culling) const {
+    // Whether a rule that culls (either: they differ only for planes) skips this triangle of
+    // this object for this (world-space) ray, decided as prism's own index decides it: meshes by
+    // their winding in object space.
+    bool culled(std::uint32_t object, std::uint32_t primitive, const Ray<Real>& ray) const {
         const Instance& instance = instances_[object];
-        if (instance.kind != Kind::mesh || culling == BackfaceCulling::none) return false;
+        if (instance.kind != Kind::mesh) return false;
         return meshes_[instance.shape].faces_away(primitive, instance.template ray_to_object<MotionBlur>(ray).direction);
     }
     const Placement<Real>& placement(std::uint32_t object) const { return instances_[object]; }
