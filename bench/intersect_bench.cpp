@@ -399,7 +399,7 @@ void trace_tree(const Workload& workload, const RayBatch& batch, Answers& answer
         for (std::size_t i = 0; i < rays.size(); ++i) {
             float t_max = rays[i].t_max;
             prism::Hit<float> hit;
-            answers[i] = mesh.template intersect<false>(rays[i], t_max, hit);
+            answers[i] = mesh.intersect(rays[i], t_max, hit, false);
         }
     }
 }

@@ -1364,8 +1364,8 @@ TEST_CASE_TEMPLATE("TriangleMesh: the caller's shared ray set-up finds the hits 
             Real t_own = ray.t_max, t_shared = ray.t_max;
             const typename Mesh::TraversalRay traversal_ray(ray);
             const typename Mesh::TriangleRay triangle_ray(ray);
-            const bool own = triangle_mesh.template intersect<false>(ray, t_own, own_hit);
-            const bool shared = triangle_mesh.template intersect<false>(ray, traversal_ray, triangle_ray, t_shared, shared_hit);
+            const bool own = triangle_mesh.intersect(ray, t_own, own_hit, false);
+            const bool shared = triangle_mesh.intersect(ray, traversal_ray, triangle_ray, t_shared, shared_hit, false);
             hits += own;
             differ += own != shared || t_own != t_shared ||
                       (own && (own_hit.primitive != shared_hit.primitive || own_hit.b1 != shared_hit.b1 ||

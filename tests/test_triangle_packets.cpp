@@ -121,10 +121,7 @@ void check_every_leaf_count() {
                         found_scalar = true;
                     }
                 }
-                const bool found_packed = cull ? packets.template intersect<true>(packed, ray.direction, leaf.first, leaf.count,
-                                                                                  ray.t_min, t_packed, packed_hit)
-                                               : packets.template intersect<false>(packed, ray.direction, leaf.first,
-                                                                                   leaf.count, ray.t_min, t_packed, packed_hit);
+                const bool found_packed = packets.intersect(packed, ray.direction, leaf.first, leaf.count, ray.t_min, t_packed, packed_hit, cull);
                 later_ties += equal_t;
                 hits_at_t_max += found_scalar && t_scalar == ray.t_max && std::isfinite(ray.t_max);
                 hits += found_scalar;

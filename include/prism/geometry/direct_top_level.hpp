@@ -132,8 +132,7 @@ public:
 
     // The closest hit among the objects, in their order (spheres, then meshes), below ray.t_max
     // (lowered to it, hit filled); `found`: something nearer was hit already.
-    template <bool Cull>
-    PRISM_FORCE_INLINE bool closest(Ray<Real>& ray, Hit<Real>& hit, bool found) const {
+    PRISM_FORCE_INLINE bool closest(Ray<Real>& ray, Hit<Real>& hit, bool found, bool cull) const {
         const Candidates may = candidates(ray);
         for (std::uint32_t lanes = may.spheres; lanes != 0; lanes &= lanes - 1) {
             const DirectSphere& sphere = spheres_[std::size_t(std::countr_zero(lanes))];
@@ -152,8 +151,7 @@ public:
                 const std::optional<Ray<Real>> local = mesh_ray(direct, ray);
                 if (!local) continue;
                 const typename Mesh::TriangleRay triangle_ray(*local);
-                if (Cull ? direct.mesh->template intersect_leaf<true>(*local, triangle_ray, direct.leaf, ray.t_max, hit)
-                                              : direct.mesh->template intersect_leaf<false>(*local, triangle_ray, direct.leaf, ray.t_max, hit)) {
+                if (direct.mesh->intersect_leaf(*local, triangle_ray, direct.leaf, ray.t_max, hit, cull)) {
                     hit.object = direct.object;
                     found = true;
                 }

@@ -146,15 +146,16 @@ public:
     // A batch of one is inlined into the caller down to closest_one's dispatch.
     // Every route below tests every surface but the planes; the entry tests the planes last,
     // from the t_max the route leaves (where each route had tested them, so the same hits).
-    // Only BackfaceCulling::all culls planes, and triangles cull under both rules that cull:
-    // so the routes are compiled for two rules (Cull: the triangles' rule) and the planes
-    // take theirs at run time. Compiled for all three, the third copy of every route was a
-    // tenth of the prism binary's code, and of a consumer's compile.
+    // Only BackfaceCulling::all culls planes, and triangles cull under both rules that cull.
+    // Both are run-time choices: the routes take the triangles' as `cull`, which the leaf
+    // tests read only where a triangle is hit, and the planes take theirs here. Compiled for
+    // each rule, every route was two or three copies: each copy an eighth of the prism
+    // binary's code.
     PRISM_FORCE_INLINE std::uint32_t intersect(const RayBatch<Real>& batch, Hit<Real>* hits) const {
         if (batch.count == 1) {
             if (!(batch.active & 1)) return 0;
             Ray<Real>& ray = batch.rays[0];
-            const bool found = culls_back_faces(batch.culling) ? closest_one<true>(ray, hits[0]) : closest_one<false>(ray, hits[0]);
+            const bool found = closest_one(ray, hits[0], culls_back_faces(batch.culling));
             return planes_.closest(ray, hits[0], batch.culling == BackfaceCulling::all) || found;
         }
         return closest_many(batch, hits);
@@ -194,21 +195,19 @@ private:
     // form stays one out-of-line function. GCC weighed the two as one: once the kernel's slab test changed size it stopped
     // inlining the whole, and every camera ray of the sphere scenes paid a call and its spills
     // (3% of hw1 simple_shading's CPU time, 8-13% of hw1 two_spheres').
-    template <bool Cull>
-    PRISM_FORCE_INLINE bool closest_one(Ray<Real>& ray, Hit<Real>& hit) const {
+    PRISM_FORCE_INLINE bool closest_one(Ray<Real>& ray, Hit<Real>& hit, bool cull) const {
         if (direct_form_) {
-            const bool found = !world_meshes_.empty() && (several_leaves_ ? intersect_world_leaves<Cull, true>(ray, hit)
-                                                                       : intersect_world_leaves<Cull, false>(ray, hit));
-            return direct_.template closest<Cull>(ray, hit, found);
+            const bool found = !world_meshes_.empty() && (several_leaves_ ? intersect_world_leaves<true>(ray, hit, cull)
+                                                                       : intersect_world_leaves<false>(ray, hit, cull));
+            return direct_.closest(ray, hit, found, cull);
         }
-        return intersect_indexed<Cull>(ray, hit);
+        return intersect_indexed(ray, hit, cull);
     }
 
     // A batch of several rays, traversed as route() says: side by side, the active rays first
     // gathered to the front if the mask has gaps (closest_dense), or ray by ray.
     std::uint32_t closest_many(const RayBatch<Real>& batch, Hit<Real>* hits) const {
-        std::uint32_t found = culls_back_faces(batch.culling) ? closest_gathered<true>(batch, hits)
-                                                              : closest_gathered<false>(batch, hits);
+        std::uint32_t found = closest_gathered(batch, hits, culls_back_faces(batch.culling));
         if (planes_.empty()) return found;
         const bool cull_planes = batch.culling == BackfaceCulling::all;
         for (std::uint32_t lanes = batch.active; lanes != 0; lanes &= lanes - 1) {
@@ -217,22 +216,21 @@ private:
         }
         return found;
     }
-    template <bool Cull>
-    std::uint32_t closest_gathered(const RayBatch<Real>& batch, Hit<Real>* hits) const {
+    std::uint32_t closest_gathered(const RayBatch<Real>& batch, Hit<Real>* hits, bool cull) const {
         const BatchRoute way = route(std::popcount(batch.active));
         if (way == BatchRoute::ray_by_ray) {
             std::uint32_t found = 0;
             for (std::uint32_t lanes = batch.active; lanes != 0; lanes &= lanes - 1) {
                 const int i = std::countr_zero(lanes);
-                if (closest_one<Cull>(batch.rays[i], hits[i])) found |= std::uint32_t(1) << i;
+                if (closest_one(batch.rays[i], hits[i], cull)) found |= std::uint32_t(1) << i;
             }
             return found;
         }
-        if (batch.dense()) return closest_dense<Cull>(way, batch.rays, hits, batch.count);
+        if (batch.dense()) return closest_dense(way, batch.rays, hits, batch.count, cull);
         Gathered gathered(batch);
         Hit<Real> gathered_hits[RayBatch<Real>::max_rays];
         for (int k = 0; k < gathered.count; ++k) gathered_hits[k] = hits[gathered.index[k]];
-        const std::uint32_t found = closest_dense<Cull>(way, gathered.rays, gathered_hits, gathered.count);
+        const std::uint32_t found = closest_dense(way, gathered.rays, gathered_hits, gathered.count, cull);
         for (int k = 0; k < gathered.count; ++k) {
             batch.rays[gathered.index[k]].t_max = gathered.rays[k].t_max;
             hits[gathered.index[k]] = gathered_hits[k];
@@ -281,8 +279,7 @@ private:
     };
 
     // intersect through the top-level index (scenes that chose no direct form).
-    template <bool Cull>
-    bool intersect_indexed(Ray<Real>& ray, Hit<Real>& hit) const {
+    bool intersect_indexed(Ray<Real>& ray, Hit<Real>& hit, bool cull) const {
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;  // made when the ray first enters a mesh
         // The merged world-space meshes first: their hit lowers t_max before the top level
@@ -291,18 +288,15 @@ private:
         std::optional<RayBoxPrecomputed<Real>> box_ray;  // made once, for the first group's box
         for (const WorldMeshes& group : world_meshes_) {
             const Mesh& index = index_of(group);
-            const bool cull = Cull;
             bool group_hit = false;
             if (group.leaves) {
                 if constexpr (Mesh::packed) {
-                    group_hit = cull ? intersect_root_leaves<true, true>(index, *group.leaves, ray, world_triangle_ray, hit)
-                                     : intersect_root_leaves<false, true>(index, *group.leaves, ray, world_triangle_ray, hit);
+                    group_hit = intersect_root_leaves<true>(index, *group.leaves, ray, world_triangle_ray, hit, cull);
                 }
             } else {
                 if (!enters(index, ray, traversal_ray, box_ray)) continue;
                 if (!world_triangle_ray) world_triangle_ray.emplace(ray);
-                group_hit = cull ? index.template intersect<true>(ray, traversal_ray, *world_triangle_ray, ray.t_max, hit)
-                                 : index.template intersect<false>(ray, traversal_ray, *world_triangle_ray, ray.t_max, hit);
+                group_hit = index.intersect(ray, traversal_ray, *world_triangle_ray, ray.t_max, hit, cull);
             }
             if (group_hit) {
                 if (group.index) group.attribute(index.source_triangle(hit.primitive), hit);
@@ -310,7 +304,7 @@ private:
                 found = true;
             }
         }
-        return intersect_top<Cull>(ray, hit, found, traversal_ray, world_triangle_ray);
+        return intersect_top(ray, hit, found, traversal_ray, world_triangle_ray, cull);
     }
 
     // occluded_one in a scene with an index (no direct form).
@@ -355,18 +349,14 @@ private:
 
     // Batches side by side (geometry/scene_index_lanes.hpp).
     static constexpr int index_lanes = 16;
-    template <bool Cull>
-    std::uint32_t closest_dense(BatchRoute way, Ray<Real>* rays, Hit<Real>* hits, int count) const;
+    std::uint32_t closest_dense(BatchRoute way, Ray<Real>* rays, Hit<Real>* hits, int count, bool cull) const;
     std::uint32_t occluded_dense(BatchRoute way, const Ray<Real>* rays, int count) const;
-    template <bool Cull>
-    std::uint32_t intersect_through_index(Ray<Real>* rays, Hit<Real>* hits, int count) const
-        requires Mesh::packed;
-    template <bool Cull>
-    std::uint32_t intersect_in_object_space(const Placement<Real>& instance, const Ray<Real>* rays, const Real* t_min,
-                                            Real* t_max, std::uint32_t lanes, Hit<Real>* hits, std::uint32_t& tied) const
-        requires Mesh::packed;
     // Called only where Mesh::packed (under if constexpr): a trailing requires-clause on these
-    // two, out of line, is more than clang 14 can match to its declaration.
+    // four, out of line and not templates, is more than clang 14 can match to its declaration.
+    std::uint32_t intersect_through_index(Ray<Real>* rays, Hit<Real>* hits, int count, bool cull) const;
+    std::uint32_t intersect_in_object_space(const Placement<Real>& instance, const Ray<Real>* rays, const Real* t_min,
+                                            Real* t_max, std::uint32_t lanes, Hit<Real>* hits, std::uint32_t& tied,
+                                            bool cull) const;
     std::uint32_t occluded_through_index(const Ray<Real>* rays, int count) const;
     std::uint32_t occludes_in_object_space(const Placement<Real>& instance, const Ray<Real>* rays, const Real* t_min,
                                            const Real* t_max, std::uint32_t lanes) const;
@@ -414,17 +404,16 @@ private:
 
     // intersect_indexed past the world meshes: the top level (direct or through its index);
     // `found` whether the world meshes were hit.
-    template <bool Cull>
     PRISM_FORCE_INLINE bool intersect_top(Ray<Real>& ray, Hit<Real>& hit, bool found, const TraversalRay& traversal_ray,
-                                              std::optional<TriangleRay>& world_triangle_ray) const {
-        if (direct_.chosen()) return direct_.template closest<Cull>(ray, hit, found);
+                                              std::optional<TriangleRay>& world_triangle_ray, bool cull) const {
+        if (direct_.chosen()) return direct_.closest(ray, hit, found, cull);
         if (top_objects_.empty()) return found;
         const auto& order = top_.primitive_indices();
         top_.traverse_closest(traversal_ray, ray.t_min, ray.t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_max) {
             bool leaf_hit = false;
             for (std::uint32_t i = first; i < first + count; ++i) {
                 const std::uint32_t object = top_objects_[order[i]];
-                if (intersect_instance<Cull>(placements_[object], ray, traversal_ray, world_triangle_ray, t_max, hit)) {
+                if (intersect_instance(placements_[object], ray, traversal_ray, world_triangle_ray, t_max, hit, cull)) {
                     hit.object = object;
                     leaf_hit = true;
                 }
@@ -456,21 +445,18 @@ private:
 
     // Forced inline, as occludes below: the top level's leaf callbacks call them for every
     // object they reach, and with to_object forced inline GCC put both out of line (nm).
-    template <bool Cull>
     PRISM_FORCE_INLINE bool intersect_instance(const Placement<Real>& instance, const Ray<Real>& ray,
                                                    const TraversalRay& traversal_ray,
                                                    std::optional<TriangleRay>& world_triangle_ray, Real& t_max,
-                                                   Hit<Real>& hit) const {
+                                                   Hit<Real>& hit, bool cull) const {
         if (instance.kind == Kind::mesh) {
             const auto& mesh = mesh_at(instance.shape);
-            const bool cull = Cull;
             if (instance.template in_world_space<MotionBlur>()) {
                 if (!world_triangle_ray) world_triangle_ray.emplace(ray);
-                return cull ? mesh.template intersect<true>(ray, traversal_ray, *world_triangle_ray, t_max, hit)
-                            : mesh.template intersect<false>(ray, traversal_ray, *world_triangle_ray, t_max, hit);
+                return mesh.intersect(ray, traversal_ray, *world_triangle_ray, t_max, hit, cull);
             }
             const Ray<Real> local = instance.template ray_to_object<MotionBlur>(ray);
-            return cull ? mesh.template intersect<true>(local, t_max, hit) : mesh.template intersect<false>(local, t_max, hit);
+            return mesh.intersect(local, t_max, hit, cull);
         }
         const Ray<Real> local = instance.template ray_to_object<MotionBlur>(ray);
         Real t;
@@ -527,16 +513,14 @@ private:
     // The world-space meshes' leaves for intersect's direct path: hit or not, and hit filled as
     // intersect's loop over the indices fills it.
     // Several: some index has more than one (several_leaves_); without, the one-leaf code alone.
-    template <bool Cull, bool Several>
-    bool intersect_world_leaves(Ray<Real>& ray, Hit<Real>& hit) const {
+    template <bool Several>
+    bool intersect_world_leaves(Ray<Real>& ray, Hit<Real>& hit, bool cull) const {
         if constexpr (Mesh::packed) {
             std::optional<TriangleRay> triangle_ray;  // made for the first leaf the ray may reach
             bool found = false;
             for (const WorldMeshes& group : world_meshes_) {
                 const Mesh& index = index_of(group);
-                const bool cull = Cull;
-                const bool group_hit = cull ? intersect_root_leaves<true, Several>(index, *group.leaves, ray, triangle_ray, hit)
-                                            : intersect_root_leaves<false, Several>(index, *group.leaves, ray, triangle_ray, hit);
+                const bool group_hit = intersect_root_leaves<Several>(index, *group.leaves, ray, triangle_ray, hit, cull);
                 if (group_hit) {
                     if (group.index) group.attribute(index.source_triangle(hit.primitive), hit);
                     else hit.object = group.objects[0];
@@ -557,15 +541,15 @@ private:
     // nearest distances depend on the order (the later leaf wins), and the traversal orders
     // leaves by their boxes' entry distances: those rays (an edge shared by two leaves) are
     // handed to the traversal itself, from the state before any leaf.
-    template <bool CullBackfaces, bool Several>
+    template <bool Several>
     PRISM_FORCE_INLINE static bool intersect_root_leaves(const Mesh& index, const typename Mesh::RootLeaves& leaves,
                                                              Ray<Real>& ray, std::optional<TriangleRay>& triangle_ray,
-                                                             Hit<Real>& hit) {
+                                                             Hit<Real>& hit, bool cull) {
         const auto& first = leaves.leaf[0];
         if (!Several || leaves.count == 1) {
             if (leaves_box(first.box, ray)) return false;
             if (!triangle_ray) triangle_ray.emplace(ray);
-            return index.template intersect_leaf<CullBackfaces>(ray, *triangle_ray, first, ray.t_max, hit);
+            return index.intersect_leaf(ray, *triangle_ray, first, ray.t_max, hit, cull);
         }
         Real nearest = ray.t_max;
         Hit<Real> nearest_hit;
@@ -577,7 +561,7 @@ private:
             if (!triangle_ray) triangle_ray.emplace(ray);
             Real t = ray.t_max;
             Hit<Real> candidate = hit;
-            if (!index.template intersect_leaf<CullBackfaces>(ray, *triangle_ray, leaf, t, candidate)) continue;
+            if (!index.intersect_leaf(ray, *triangle_ray, leaf, t, candidate, cull)) continue;
             if (found && t == nearest) {
                 tied = true;
                 continue;
@@ -588,7 +572,7 @@ private:
             found = true;
             tied = false;
         }
-        if (tied) return index.template intersect<CullBackfaces>(ray, TraversalRay(ray), *triangle_ray, ray.t_max, hit);
+        if (tied) return index.intersect(ray, TraversalRay(ray), *triangle_ray, ray.t_max, hit, cull);
         if (!found) return false;
         ray.t_max = nearest;
         hit = nearest_hit;

@@ -95,13 +95,13 @@ inline typename Packets::LanePack SceneIndex<Real, Policy, MotionBlur>::lanes_t_
 // BatchRoute::index_lanes: the rays traverse the index together (intersect_through_index).
 template <Scalar Real, class Policy, bool MotionBlur>
     requires AccelerationPolicy<Policy, Real>
-template <bool Cull>
-std::uint32_t SceneIndex<Real, Policy, MotionBlur>::closest_dense(BatchRoute way, Ray<Real>* rays, Hit<Real>* hits, int count) const {
+std::uint32_t SceneIndex<Real, Policy, MotionBlur>::closest_dense(BatchRoute way, Ray<Real>* rays, Hit<Real>* hits, int count,
+                                                                  bool cull) const {
     std::uint32_t found = 0;
     if (way == BatchRoute::index_lanes) {
         if constexpr (Mesh::packed) {
             for (int first = 0; first < count; first += index_lanes)
-                found |= intersect_through_index<Cull>(rays + first, hits + first, std::min(index_lanes, count - first))
+                found |= intersect_through_index(rays + first, hits + first, std::min(index_lanes, count - first), cull)
                          << first;
         }
         return found;
@@ -134,10 +134,7 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::closest_dense(BatchRoute way
                         if (lanes == 0) continue;
                         if (!lanes_ray) lanes_ray.emplace(group, n);
                         lane_hits.found = 0;
-                        if (Cull)
-                            index.template intersect_leaf_lanes<true>(*lanes_ray, leaf, lanes, lane_hits);
-                        else
-                            index.template intersect_leaf_lanes<false>(*lanes_ray, leaf, lanes, lane_hits);
+                        index.intersect_leaf_lanes(*lanes_ray, leaf, lanes, lane_hits, cull);
                         std::uint32_t taken = lane_hits.found & lanes;
                         if (taken == 0) continue;
                         alignas(64) Real t[width], b1[width], b2[width];
@@ -176,7 +173,7 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::closest_dense(BatchRoute way
                     const int i = std::countr_zero(tied);
                     group[i].t_max = given_t_max[i];
                     group_hits[i] = given_hits[i];
-                    if (!closest_one<Cull>(group[i], group_hits[i])) world_hits &= ~(std::uint32_t(1) << i);
+                    if (!closest_one(group[i], group_hits[i], cull)) world_hits &= ~(std::uint32_t(1) << i);
                 }
                 found |= world_hits << first;
             }
@@ -248,10 +245,8 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::occluded_dense(BatchRoute wa
 // where it was before the mesh, so every ray's hit is intersect's.
 template <Scalar Real, class Policy, bool MotionBlur>
     requires AccelerationPolicy<Policy, Real>
-template <bool Cull>
-std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_through_index(Ray<Real>* rays, Hit<Real>* hits, int count) const
-    requires Mesh::packed
-{
+std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_through_index(Ray<Real>* rays, Hit<Real>* hits, int count,
+                                                                            bool cull) const {
     const std::uint32_t present = (std::uint32_t(1) << count) - 1;
     WorldSpaceRays world(rays, count);
     Real* const t_min = world.t_min;
@@ -260,7 +255,6 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_through_index(Ray<
     std::uint32_t found = 0;
     for (const WorldMeshes& group : world_meshes_) {
         const Mesh& index = index_of(group);
-        const bool cull = Cull;
         std::uint32_t lanes = 0;
         for (std::uint32_t rest = present; rest != 0; rest &= rest - 1) {
             const int i = std::countr_zero(rest);
@@ -278,20 +272,14 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_through_index(Ray<
         }
         std::uint32_t tied = 0;
         std::uint32_t group_hits =
-            cull ? index.template intersect_lanes<true>(rays, traversal.data(), world_triangle, t_min, t_max, lanes, hits,
-                                                        tied)
-                 : index.template intersect_lanes<false>(rays, traversal.data(), world_triangle, t_min, t_max, lanes, hits,
-                                                         tied);
+            index.intersect_lanes(rays, traversal.data(), world_triangle, t_min, t_max, lanes, hits, tied, cull);
         for (; tied != 0; tied &= tied - 1) {
             const int i = std::countr_zero(tied);
             const std::uint32_t bit = std::uint32_t(1) << i;
             t_max[i] = t_before[std::size_t(i)];
             hits[i] = hit_before[std::size_t(i)];
             rays[i].t_max = t_max[i];
-            const bool hit = cull ? index.template intersect<true>(rays[i], traversal[std::size_t(i)], world_triangle[i],
-                                                                   t_max[i], hits[i])
-                                  : index.template intersect<false>(rays[i], traversal[std::size_t(i)],
-                                                                    world_triangle[i], t_max[i], hits[i]);
+            const bool hit = index.intersect(rays[i], traversal[std::size_t(i)], world_triangle[i], t_max[i], hits[i], cull);
             group_hits = hit ? group_hits | bit : group_hits & ~bit;
         }
         for (std::uint32_t rest = group_hits; rest != 0; rest &= rest - 1) {
@@ -309,7 +297,7 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_through_index(Ray<
             // Made again where a top-level mesh in world space needs it (its set-up is the
             // ray's alone, so the same bits).
             std::optional<TriangleRay> world_triangle_ray;
-            if (intersect_top<Cull>(rays[i], hits[i], (found >> i) & 1, traversal[std::size_t(i)], world_triangle_ray))
+            if (intersect_top(rays[i], hits[i], (found >> i) & 1, traversal[std::size_t(i)], world_triangle_ray, cull))
                 answer |= std::uint32_t(1) << i;
         }
         return answer;
@@ -334,13 +322,9 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_through_index(Ray<
                 if (instance.kind == Kind::mesh && instance.template in_world_space<MotionBlur>()) {
                     const TriangleRay* const world_triangle = world.triangles(testing);
                     const Mesh& mesh = mesh_at(instance.shape);
-                    instance_hits = Cull
-                                        ? mesh.template intersect_lanes<true>(rays, traversal.data(), world_triangle, t_min,
-                                                                              t_max, testing, hits, tied)
-                                        : mesh.template intersect_lanes<false>(rays, traversal.data(), world_triangle, t_min,
-                                                                               t_max, testing, hits, tied);
+                    instance_hits = mesh.intersect_lanes(rays, traversal.data(), world_triangle, t_min, t_max, testing, hits, tied, cull);
                 } else {
-                    instance_hits = intersect_in_object_space<Cull>(instance, rays, t_min, t_max, testing, hits, tied);
+                    instance_hits = intersect_in_object_space(instance, rays, t_min, t_max, testing, hits, tied, cull);
                 }
                 for (std::uint32_t rest = instance_hits; rest != 0; rest &= rest - 1)
                     hits[std::countr_zero(rest)].object = object;
@@ -357,8 +341,8 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_through_index(Ray<
             hits[i] = hit_before[std::size_t(i)];
             rays[i].t_max = t_max[i];
             std::optional<TriangleRay> world_triangle_ray;
-            if (intersect_top<Cull>(rays[i], hits[i], (world_found & bit) != 0, traversal[std::size_t(i)],
-                                       world_triangle_ray))
+            if (intersect_top(rays[i], hits[i], (world_found & bit) != 0, traversal[std::size_t(i)],
+                                       world_triangle_ray, cull))
                 answer |= bit;
             continue;
         }
@@ -373,11 +357,8 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_through_index(Ray<
 // TriangleMesh::intersect_lanes sets it (a sphere's hit at the t_max it was given, too).
 template <Scalar Real, class Policy, bool MotionBlur>
     requires AccelerationPolicy<Policy, Real>
-template <bool Cull>
 std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_in_object_space(const Placement<Real>& instance, const Ray<Real>* rays, const Real* t_min, Real* t_max,
-                                        std::uint32_t lanes, Hit<Real>* hits, std::uint32_t& tied) const
-    requires Mesh::packed
-{
+                                        std::uint32_t lanes, Hit<Real>* hits, std::uint32_t& tied, bool cull) const {
     std::uint32_t hit = 0;
     if (instance.kind != Kind::mesh) {
         for (; lanes != 0; lanes &= lanes - 1) {
@@ -396,11 +377,7 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_in_object_space(co
     ObjectSpaceRays local;
     local.make(instance, rays, lanes);
     const Mesh& mesh = mesh_at(instance.shape);
-    return Cull
-               ? mesh.template intersect_lanes<true>(local.ray.data(), local.traversal.data(), local.triangle.data(),
-                                                     t_min, t_max, lanes, hits, tied)
-               : mesh.template intersect_lanes<false>(local.ray.data(), local.traversal.data(), local.triangle.data(),
-                                                      t_min, t_max, lanes, hits, tied);
+    return mesh.intersect_lanes(local.ray.data(), local.traversal.data(), local.triangle.data(), t_min, t_max, lanes, hits, tied, cull);
 }
 
 // occluded_dense in a scene traversed through its index (no direct form), for up to

@@ -168,22 +168,21 @@ public:
     // The leaf's test itself, as traversal calls it on that leaf: the same packets, slots and
     // order, so the same hit (closest in (ray.t_min, t_max], later ties winning; t_max lowered)
     // and the same any-hit answer (open at t_max).
-    template <bool CullBackfaces>
     PRISM_FORCE_INLINE bool intersect_leaf(const Ray<Real>& ray, const TriangleRay& triangle_ray, Leaf leaf, Real& t_max,
-                                               Hit<Real>& hit) const
+                                               Hit<Real>& hit, bool cull_back_faces) const
         requires packed
     {
-        return packets_.template intersect<CullBackfaces>(triangle_ray.packed_ray, ray.direction, leaf.first, leaf.count,
-                                                          ray.t_min, t_max, hit);
+        return packets_.intersect(triangle_ray.packed_ray, ray.direction, leaf.first, leaf.count, ray.t_min, t_max, hit,
+                                  cull_back_faces);
     }
     // The same leaf against several rays, one in each lane (TrianglePackets::intersect_lanes):
     // each lane's hit is the one intersect_leaf gives its ray.
-    template <bool CullBackfaces, class RayLanes, class LaneHits>
-    PRISM_FORCE_INLINE void intersect_leaf_lanes(const RayLanes& rays, Leaf leaf, std::uint32_t lanes,
-                                                     LaneHits& hits) const
+    template <class RayLanes, class LaneHits>
+    PRISM_FORCE_INLINE void intersect_leaf_lanes(const RayLanes& rays, Leaf leaf, std::uint32_t lanes, LaneHits& hits,
+                                                     bool cull_back_faces) const
         requires packed
     {
-        packets_.template intersect_lanes<CullBackfaces>(rays, leaf.first, leaf.count, lanes, hits);
+        packets_.intersect_lanes(rays, leaf.first, leaf.count, lanes, hits, cull_back_faces);
     }
     template <class RayLanes, class LanePack>
     PRISM_FORCE_INLINE std::uint32_t occluded_leaf_lanes(const RayLanes& rays, Leaf leaf, std::uint32_t lanes,
@@ -199,24 +198,24 @@ public:
     }
 
     // Closest hit along `ray` (object space) below t_max; lowers t_max and fills t, primitive,
-    // barycentrics. Culling skips triangles whose winding faces away from the ray.
-    template <bool CullBackfaces>
-    bool intersect(const Ray<Real>& ray, Real& t_max, Hit<Real>& hit) const {
-        return intersect<CullBackfaces>(ray, TraversalRay(ray), TriangleRay(ray), t_max, hit);
+    // barycentrics. cull_back_faces skips triangles whose winding faces away from the ray
+    // (a camera ray's rule, geometry/backface_culling.hpp): a choice at run time, tested only
+    // where a triangle is hit, so every route through the index is compiled once for both.
+    bool intersect(const Ray<Real>& ray, Real& t_max, Hit<Real>& hit, bool cull_back_faces) const {
+        return intersect(ray, TraversalRay(ray), TriangleRay(ray), t_max, hit, cull_back_faces);
     }
 
     // The same with the ray's traversal and triangle set-up made by the caller, who may share
     // them between meshes in one space (SceneIndex, for meshes in world space).
-    template <bool CullBackfaces>
     bool intersect(const Ray<Real>& ray, const TraversalRay& traversal_ray, const TriangleRay& triangle_ray, Real& t_max,
-                   Hit<Real>& hit) const {
+                   Hit<Real>& hit, bool cull_back_faces) const {
         const Prepared& prepared = triangle_ray.prepared;
         if constexpr (packed) {
             const typename Packets::PackedRay& packed_ray = triangle_ray.packed_ray;
             bool found = false;
             index_.traverse_closest(traversal_ray, ray.t_min, t_max, [&](std::uint32_t first, std::uint32_t count, Real& t_limit) {
-                const bool leaf_hit = packets_.template intersect<CullBackfaces>(packed_ray, ray.direction, first,
-                                                                                 count, ray.t_min, t_limit, hit);
+                const bool leaf_hit =
+                    packets_.intersect(packed_ray, ray.direction, first, count, ray.t_min, t_limit, hit, cull_back_faces);
                 found |= leaf_hit;
                 return leaf_hit;
             }, [&](std::uint32_t first) PRISM_PREFETCH_INLINE { packets_.prefetch(first); });
@@ -227,9 +226,7 @@ public:
             bool leaf_hit = false;
             for (std::uint32_t slot = first; slot < first + count; ++slot) {
                 const auto& p = triangles_[slot];
-                if constexpr (CullBackfaces) {
-                    if (glm::dot(Vec3<Real>(glm::cross(p[1] - p[0], p[2] - p[0])), ray.direction) > 0) continue;
-                }
+                if (cull_back_faces && glm::dot(Vec3<Real>(glm::cross(p[1] - p[0], p[2] - p[0])), ray.direction) > 0) continue;
                 TriangleHit<Real> triangle_hit;
                 if (Intersector::intersect(prepared, p[0], p[1], p[2], ray.t_min, t_limit, triangle_hit)) {
                     t_limit = triangle_hit.t;
@@ -284,10 +281,9 @@ public:
     // shared by two leaves' triangles): so each leaf is tested up to the next Real above
     // t_max, where such a hit is taken and the ray counted tied. The caller traces tied rays
     // again with intersect, from what they had before.
-    template <bool CullBackfaces>
     std::uint32_t intersect_lanes(const Ray<Real>* rays, const TraversalRay* traversal, const TriangleRay* triangle,
                                   const Real* t_min, Real* t_max, std::uint32_t lanes, Hit<Real>* hits,
-                                  std::uint32_t& tied) const
+                                  std::uint32_t& tied, bool cull_back_faces) const
         requires packed
     {
         return index_.traverse_closest_lanes(
@@ -297,8 +293,8 @@ public:
                     const int i = std::countr_zero(testing);
                     const Real before = t_max[i];
                     if constexpr (!std::is_same_v<Storage, Real>) t_max[i] = std::nextafter(before, infinity<Real>);
-                    if (!packets_.template intersect<CullBackfaces>(triangle[i].packed_ray, rays[i].direction, first, count,
-                                                                    rays[i].t_min, t_max[i], hits[i])) {
+                    if (!packets_.intersect(triangle[i].packed_ray, rays[i].direction, first, count, rays[i].t_min,
+                                            t_max[i], hits[i], cull_back_faces)) {
                         t_max[i] = before;
                         continue;
                     }

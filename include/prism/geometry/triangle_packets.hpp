@@ -97,9 +97,8 @@ public:
     // Closest hit among slots [first, first + count) (first a multiple of N); lowers t_limit.
     // Forced inline into the traversal's leaf callback, as is `test`: GCC had kept it a function
     // of its own (26% of a dragon primary profile), called once per leaf.
-    template <bool CullBackfaces>
     PRISM_FORCE_INLINE bool intersect(const PackedRay& ray, const Vec3<Real>& direction, std::uint32_t first, std::uint32_t count,
-                   Real t_min, Real& t_limit, Hit<Real>& hit) const {
+                   Real t_min, Real& t_limit, Hit<Real>& hit, bool cull_back_faces) const {
         bool found = false;
         const LeafRay leaf_ray(ray.ray);
         for (std::uint32_t base = first; base < first + count; base += N) {
@@ -110,9 +109,7 @@ public:
                 const int lane = std::countr_zero(lanes);
                 lanes &= lanes - 1;
                 const std::uint32_t slot = base + std::uint32_t(lane);
-                if constexpr (CullBackfaces) {
-                    if (glm::dot(normals_[slot], direction) > 0) continue;
-                }
+                if (cull_back_faces && glm::dot(normals_[slot], direction) > 0) continue;
                 // The scalar loop's acceptance, lane by lane in slot order: later ties win.
                 if (!(t[lane] <= Storage(t_limit))) continue;
                 t_limit = Real(t[lane]);
@@ -210,13 +207,13 @@ public:
     };
 
     // Closest hits among slots [first, first + count) for the lanes of `lanes`.
-    template <bool CullBackfaces>
-        requires tests_ray_lanes
     PRISM_FORCE_INLINE void intersect_lanes(const RayLanes& rays, std::uint32_t first, std::uint32_t count,
-                                                std::uint32_t lanes, LaneHits& hits) const {
+                                                std::uint32_t lanes, LaneHits& hits, bool cull_back_faces) const
+        requires tests_ray_lanes
+    {
         for (std::uint32_t slot = first; slot < first + count; ++slot) {
             SlotLanes test;
-            if (!test_slot<CullBackfaces>(rays, slot, lanes, test)) continue;
+            if (!test_slot(rays, slot, lanes, test, cull_back_faces)) continue;
             const LaneMask accepted = test.accepted & (test.t > rays.t_min) & (test.t <= hits.t_max);
             std::uint32_t taken = accepted.bits() & lanes;
             if (taken == 0) continue;
@@ -237,7 +234,7 @@ public:
         std::uint32_t blocked = 0;
         for (std::uint32_t slot = first; slot < first + count && lanes != 0; ++slot) {
             SlotLanes test;
-            if (!test_slot<false>(rays, slot, lanes, test)) continue;
+            if (!test_slot(rays, slot, lanes, test, false)) continue;
             const std::uint32_t hit = (test.accepted & (test.t > rays.t_min) & (test.t < t_max)).bits() & lanes;
             blocked |= hit;
             lanes &= ~hit;
@@ -290,8 +287,8 @@ private:
         LanePack t, v, w, inverse_det;
     };
     // False where no lane of `lanes` is accepted (t left uncomputed).
-    template <bool CullBackfaces>
-    PRISM_FORCE_INLINE bool test_slot(const RayLanes& rays, std::uint32_t slot, std::uint32_t lanes, SlotLanes& out) const {
+    PRISM_FORCE_INLINE bool test_slot(const RayLanes& rays, std::uint32_t slot, std::uint32_t lanes, SlotLanes& out,
+                                          bool cull_back_faces) const {
         const LanePack zero = LanePack::broadcast(0);
         const Packet& packet = packets_[slot / N];
         const std::size_t lane_of_slot = slot % N;
@@ -324,7 +321,7 @@ private:
         const LaneMask outside = ((u < zero) | (v < zero) | (w < zero)) & ((u > zero) | (v > zero) | (w > zero));
         const LanePack det = u + v + w;
         out.accepted = (!outside) & (det != zero);
-        if constexpr (CullBackfaces) {
+        if (cull_back_faces) {
             // glm::dot's order: (x + y) + z of the products.
             const Vec3<Real>& normal = normals_[slot];
             const LanePack facing = (LanePack::broadcast(normal.x) * rays.direction[0] +
