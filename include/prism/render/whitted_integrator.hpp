@@ -202,7 +202,7 @@ public:
         if constexpr (shades_rows) {
             Unconstructed<CameraPath, row_width> paths;
             for (int i = 0; i < count; ++i) paths.make_from(std::size_t(i), [&] { return make_path(i); });
-            shade_row<true>(rays, hits, found, count, paths.data(), nullptr, 0, radiance);
+            shade_row(rays, hits, found, count, paths.data(), nullptr, 0, radiance);
         }
     }
 
@@ -242,10 +242,11 @@ private:
     static constexpr int row_depth = 8;
 
     // radiance_row's rows at `depth`: rays[i] has travelled `travelled[i]` before its origin
-    // (camera rays, `Primary`: none, and depth 0) and draws from paths[i]. shade's work, pass
-    // by pass across the row.
-    template <bool Primary>
-        requires(!textured<Textures, Real> && std::is_same_v<LightSetT, LightSet<Real, PointLight>>)
+    // (camera rays: `travelled` null, none, and depth 0) and draws from paths[i]. shade's work,
+    // pass by pass across the row. One function for the camera rows and the reflected rows: a
+    // copy for each was 12 kB of every point-lit renderer's code. Called only where
+    // shades_rows (under if constexpr): a trailing requires-clause on a member that is not a
+    // template, defined out of line, is more than clang 14 can match to its declaration.
     void shade_row(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count, CameraPath* paths,
                    const Real* travelled, int depth, Vec3<Real>* radiance) const;
 

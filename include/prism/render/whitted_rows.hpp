@@ -142,15 +142,12 @@ void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment, Sampler
 }
 
 // radiance_row's rows at `depth`: rays[i] has travelled `travelled[i]` before its origin
-// (camera rays, `Primary`: none, and depth 0) and draws from paths[i]. shade's work, pass by
-// pass across the row.
+// (camera rays: `travelled` null, none, and depth 0) and draws from paths[i]. shade's work, pass
+// by pass across the row.
 template <Scalar Real, class Geometry, class LightSetT, class Textures, class Environment, class Sampler>
-template <bool Primary>
-    requires(!textured<Textures, Real> && std::is_same_v<LightSetT, LightSet<Real, PointLight>>)
 void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment, Sampler>::shade_row(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count,
                                                                                CameraPath* paths, const Real* travelled, int depth,
                                                                                Vec3<Real>* radiance) const {
-    if constexpr (Primary) depth = 0;
     const std::vector<PointLight<Real>>& lights = *lights_.template of_type<PointLight>();
     // What shade knows of a point before its direct lighting (the point made in place, the
     // rest of the record after it: value-initialised whole, the record had cost 5% of
@@ -250,7 +247,7 @@ void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment, Sampler
             at.color += direct;
         }
         CameraPath& path = paths[i];
-        const Real travelled_here = (Primary ? Real(0) : travelled[i]) + hits[i].t;  // shade's travelled += hit.t
+        const Real travelled_here = (travelled ? travelled[i] : Real(0)) + hits[i].t;  // shade's travelled += hit.t
         if ((material.type == scene::MaterialType::mirror || material.type == scene::MaterialType::conductor) &&
             depth < settings_.max_recursion_depth) {
             // reflect_and_absorb's mirror and conductor, the trace deferred (no medium: only
@@ -273,7 +270,7 @@ void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment, Sampler
     const std::uint32_t met = geometry_.intersect(RayBatch<Real>::all(reflections.data(), reflected_count), reflection_hits.data());
     std::array<Vec3<Real>, row_width> traced;
     if (depth + 1 < row_depth) {
-        shade_row<false>(reflections.data(), reflection_hits.data(), met, reflected_count, reflection_paths.data(),
+        shade_row(reflections.data(), reflection_hits.data(), met, reflected_count, reflection_paths.data(),
                          reached.data(), depth + 1, traced.data());
     } else {
         for (int j = 0; j < reflected_count; ++j) {
