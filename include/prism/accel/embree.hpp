@@ -107,8 +107,7 @@ public:
         for (std::uint32_t lanes = batch.active; lanes != 0; lanes &= lanes - 1) {
             const int i = std::countr_zero(lanes);
             // Triangles cull under both rules that cull; planes only under `all` (as SceneIndex).
-            const bool hit = culls_back_faces(batch.culling) ? closest_one<true>(batch.rays[i], hits[i])
-                                                             : closest_one<false>(batch.rays[i], hits[i]);
+            const bool hit = closest_one(batch.rays[i], hits[i], culls_back_faces(batch.culling));
             if (planes_.closest(batch.rays[i], hits[i], batch.culling == BackfaceCulling::all) || hit)
                 found |= std::uint32_t(1) << i;
         }
@@ -129,15 +128,15 @@ public:
 
 private:
     // Closest hit in (ray.t_min, ray.t_max] among every surface but the planes; on a hit,
-    // ray.t_max becomes the hit distance. Cull: back-facing triangles are skipped.
-    template <bool Cull>
-    bool closest_one(Ray<Real>& ray, Hit<Real>& hit) const {
+    // ray.t_max becomes the hit distance. `cull`: back-facing triangles are skipped (the
+    // filter that culls, chosen here at run time as prism's own index takes the flag).
+    bool closest_one(Ray<Real>& ray, Hit<Real>& hit, bool cull) const {
         RTCRayHit ray_hit;
         ray_hit.ray = embree_ray(ray, ray.t_max);
         ray_hit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         ray_hit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         Context context(this, ray);
-        context.base.filter = filter_for<Cull, false>();
+        context.base.filter = cull ? filter_for<true, false>() : filter_for<false, false>();
         rtcIntersect1(scene_.get(), &context.base, &ray_hit);
         bool found = false;
         if (ray_hit.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
