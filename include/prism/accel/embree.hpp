@@ -108,7 +108,7 @@ public:
             const int i = std::countr_zero(lanes);
             // Triangles cull under both rules that cull; planes only under `all` (as SceneIndex).
             const bool hit = closest_one(batch.rays[i], hits[i], culls_back_faces(batch.culling));
-            if (planes_.closest(batch.rays[i], hits[i], batch.culling == BackfaceCulling::all) || hit)
+            if (planes_.closest(batch.rays[i], hits[i], culls_planes(batch.culling)) || hit)
                 found |= std::uint32_t(1) << i;
         }
         return found;

@@ -44,5 +44,7 @@ enum class BackfaceCulling {
 
 // The rule for a mesh's triangles, whatever their shading: both rules that cull skip them.
 constexpr bool culls_back_faces(BackfaceCulling culling) { return culling != BackfaceCulling::none; }
+// The rule for planes: only `all` skips them.
+constexpr bool culls_planes(BackfaceCulling culling) { return culling == BackfaceCulling::all; }
 
 }  // namespace prism

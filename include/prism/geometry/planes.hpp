@@ -83,8 +83,8 @@ public:
 
     // The closest plane in (ray.t_min, ray.t_max] (ray.t_max lowered to it, hit filled): the
     // lanes are accepted in order as one plane after another would be, so the hit is the
-    // scalar loop's. cull_back_faces (BackfaceCulling::all): planes met from behind are skipped.
-    bool closest(Ray<Real>& ray, Hit<Real>& hit, bool cull_back_faces = false) const {
+    // scalar loop's. cull_back_faces (culls_planes): planes met from behind are skipped.
+    bool closest(Ray<Real>& ray, Hit<Real>& hit, bool cull_back_faces) const {
         bool found = false;
         for (std::size_t b = 0; b < blocks_.size(); ++b) {
             alignas(64) Real t[width];

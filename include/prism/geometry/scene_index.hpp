@@ -146,8 +146,8 @@ public:
     // A batch of one is inlined into the caller down to closest_one's dispatch.
     // Every route below tests every surface but the planes; the entry tests the planes last,
     // from the t_max the route leaves (where each route had tested them, so the same hits).
-    // Only BackfaceCulling::all culls planes, and triangles cull under both rules that cull.
-    // Both are run-time choices: the routes take the triangles' as `cull`, which the leaf
+    // Only BackfaceCulling::all culls planes, and triangles cull under both rules that cull
+    // (culls_planes, culls_back_faces). Both are run-time choices: the routes take the triangles' as `cull`, which the leaf
     // tests read only where a triangle is hit, and the planes take theirs here. Compiled for
     // each rule, every route was two or three copies: each copy an eighth of the prism
     // binary's code.
@@ -156,7 +156,7 @@ public:
             if (!(batch.active & 1)) return 0;
             Ray<Real>& ray = batch.rays[0];
             const bool found = closest_one(ray, hits[0], culls_back_faces(batch.culling));
-            return planes_.closest(ray, hits[0], batch.culling == BackfaceCulling::all) || found;
+            return planes_.closest(ray, hits[0], culls_planes(batch.culling)) || found;
         }
         return closest_many(batch, hits);
     }
@@ -192,9 +192,10 @@ public:
 private:
     // One ray's closest hit among every surface but the planes. The small scenes' direct form
     // is a dispatch to two out-of-line functions, and is inlined into the caller; the indexed
-    // form stays one out-of-line function. GCC weighed the two as one: once the kernel's slab test changed size it stopped
-    // inlining the whole, and every camera ray of the sphere scenes paid a call and its spills
-    // (3% of hw1 simple_shading's CPU time, 8-13% of hw1 two_spheres').
+    // form stays one out-of-line function. GCC weighed the two as one: once the kernel's slab
+    // test changed size it stopped inlining the whole, and every camera ray of the sphere
+    // scenes paid a call and its spills (3% of hw1 simple_shading's CPU time, 8-13% of hw1
+    // two_spheres').
     PRISM_FORCE_INLINE bool closest_one(Ray<Real>& ray, Hit<Real>& hit, bool cull) const {
         if (direct_form_) {
             const bool found = !world_meshes_.empty() && (several_leaves_ ? intersect_world_leaves<true>(ray, hit, cull)
@@ -209,7 +210,7 @@ private:
     std::uint32_t closest_many(const RayBatch<Real>& batch, Hit<Real>* hits) const {
         std::uint32_t found = closest_gathered(batch, hits, culls_back_faces(batch.culling));
         if (planes_.empty()) return found;
-        const bool cull_planes = batch.culling == BackfaceCulling::all;
+        const bool cull_planes = culls_planes(batch.culling);
         for (std::uint32_t lanes = batch.active; lanes != 0; lanes &= lanes - 1) {
             const int i = std::countr_zero(lanes);
             if (planes_.closest(batch.rays[i], hits[i], cull_planes)) found |= std::uint32_t(1) << i;

@@ -341,8 +341,8 @@ std::uint32_t SceneIndex<Real, Policy, MotionBlur>::intersect_through_index(Ray<
             hits[i] = hit_before[std::size_t(i)];
             rays[i].t_max = t_max[i];
             std::optional<TriangleRay> world_triangle_ray;
-            if (intersect_top(rays[i], hits[i], (world_found & bit) != 0, traversal[std::size_t(i)],
-                                       world_triangle_ray, cull))
+            if (intersect_top(rays[i], hits[i], (world_found & bit) != 0, traversal[std::size_t(i)], world_triangle_ray,
+                              cull))
                 answer |= bit;
             continue;
         }
