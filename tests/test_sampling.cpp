@@ -120,6 +120,43 @@ TEST_CASE_TEMPLATE("camera_samples: a jittered grid for square counts, n-rooks o
     }
 }
 
+TEST_CASE("Random::advance(k) leaves the stream where k outputs leave it") {
+    for (const std::uint64_t steps : {0ull, 1ull, 2ull, 3ull, 7ull, 64ull, 199ull, 1000ull, 123457ull}) {
+        prism::Random stepped = prism::Random::for_pixel(3, 5, 11), advanced = stepped;
+        for (std::uint64_t i = 0; i < steps; ++i) stepped.next_u32();
+        advanced.advance(steps);
+        CAPTURE(steps);
+        for (int i = 0; i < 4; ++i) CHECK(advanced.next_u32() == stepped.next_u32());
+    }
+}
+
+TEST_CASE_TEMPLATE("camera_samples: parts the render does not read are not made, and the stream goes on as if they were",
+                   Real, float, double) {
+    // Square and non-square counts (the n-rooks grid draws its shuffle too), each with the lens,
+    // the instant, both or neither left out: the pixel positions are the full draw's, the parts
+    // left out keep CameraSample's defaults, and the stream's next draws are the full draw's.
+    for (const int count : {2, 4, 6, 16, 25, 100}) {
+        for (const prism::CameraReads reads : {prism::CameraReads{false, false}, prism::CameraReads{true, false},
+                                               prism::CameraReads{false, true}, prism::CameraReads{true, true}}) {
+            CAPTURE(count);
+            CAPTURE(reads.lens);
+            CAPTURE(reads.time);
+            prism::Random full = prism::Random::for_pixel(7, 2, 5), partial = full;
+            std::vector<prism::CameraSample<Real>> all, some;
+            std::vector<prism::Vec2<Real>> scratch;
+            prism::camera_samples(count, full, all, scratch);
+            prism::camera_samples(count, partial, some, scratch, reads);
+            REQUIRE(some.size() == all.size());
+            for (std::size_t i = 0; i < all.size(); ++i) {
+                CHECK(some[i].pixel == all[i].pixel);
+                CHECK(some[i].lens == (reads.lens ? all[i].lens : prism::Vec2<Real>(Real(0.5))));
+                CHECK(some[i].time == (reads.time ? all[i].time : Real(0)));
+            }
+            for (int i = 0; i < 3; ++i) CHECK(partial.next_u32() == full.next_u32());
+        }
+    }
+}
+
 TEST_CASE_TEMPLATE("filter_weight: box is flat, the Gaussian has sigma 1/2 pixel", Real, float, double) {
     using prism::Vec2;
     CHECK(prism::filter_weight(scene::PixelFilter::box, Vec2<Real>(Real(0.1), Real(0.9))) == Real(1));

@@ -239,7 +239,7 @@ private:
             if constexpr (can_stream) {
                 if (stream) {
                     Random random = Random::for_pixel(x, y, settings_.seed);
-                    camera_samples(count, random, scratch.samples, scratch.strata);
+                    camera_samples(count, random, scratch.samples, scratch.strata, camera_reads(lens));
                     return PixelSamplerT(IndependentSampler(random));
                 }
             }

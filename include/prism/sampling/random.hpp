@@ -101,6 +101,26 @@ public:
         state_ = state_ * jump.power + increment_ * jump.sum;
     }
 
+    // Steps the stream past `steps` outputs (next_u32 calls) in O(log steps) multiplications:
+    // the LCG's k steps as one (Brown, "Random Number Generation with Arbitrary Strides", 1994,
+    // as PCG's pcg32_advance takes it), mod 2^64 as each step is, so the state is the same bits.
+    // For a count known only at run time, where skip's coefficients would take k steps to make.
+    constexpr void advance(std::uint64_t steps) {
+        std::uint64_t power = 1, sum = 0, step_power = multiplier, step_sum = increment_;
+        for (; steps != 0; steps >>= 1) {
+            if (steps & 1) {
+                power *= step_power;
+                sum = sum * step_power + step_sum;
+            }
+            step_sum = (step_power + 1) * step_sum;
+            step_power *= step_power;
+        }
+        state_ = power * state_ + sum;
+    }
+    // How many outputs uniform<Real>() takes.
+    template <Scalar Real>
+    static constexpr int outputs_per_uniform = sizeof(Real) == 4 ? 1 : 2;
+
     // Uniform integer in [0, n) (Lemire's multiply-shift; the bias is below 2^-32 n).
     constexpr std::uint32_t below(std::uint32_t n) { return std::uint32_t((std::uint64_t(next_u32()) * n) >> 32); }
 
