@@ -115,3 +115,27 @@ TEST_CASE_TEMPLATE("max_keep and min_keep are a > b ? a : b and a < b ? a : b, N
     check_keep<T, 16>();
     check_keep<T, 32>();
 }
+
+TEST_CASE_TEMPLATE("load_transposed: column j's lane i is row i's value j, the same bits, rows anywhere", T, float, double) {
+    // Rows at scattered, unaligned places (one past an odd offset into a larger buffer), some
+    // repeated, as the lanes past a batch's rays repeat its first ray; NaN and signed zeros kept.
+    constexpr int N = 8;
+    T buffer[N * 11 + 3];
+    for (int k = 0; k < N * 11 + 3; ++k) buffer[k] = T(k) * T(1.25) - T(7);
+    buffer[5] = std::numeric_limits<T>::quiet_NaN();
+    buffer[14] = T(-0.0);
+    const int offsets[N] = {1, 12, 23, 1, 45, 56, 67, 78};
+    const T* rows[N];
+    for (int i = 0; i < N; ++i) rows[i] = buffer + offsets[i];
+    prism::simd::Pack<T, N> columns[N];
+    prism::simd::load_transposed(rows, columns);
+    for (int j = 0; j < N; ++j) {
+        alignas(64) T lanes[N];
+        columns[j].store(lanes);
+        for (int i = 0; i < N; ++i) {
+            CAPTURE(i);
+            CAPTURE(j);
+            CHECK(same_bits(lanes[i], rows[i][j]));
+        }
+    }
+}

@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -190,20 +191,19 @@ public:
     template <bool AnyHit = false>
     void intersect_spheres_lanes(std::conditional_t<AnyHit, const Ray<Real>*, Ray<Real>*> rays, Hit<Real>* hits,
                                         int count, std::uint32_t& found) const {
-        alignas(64) Real fields[8][width];
-        for (int lane = 0; lane < width; ++lane) {
-            const Ray<Real>& ray = rays[lane < count ? lane : 0];
-            for (int axis = 0; axis < 3; ++axis) {
-                fields[axis][lane] = ray.origin[axis];
-                fields[3 + axis][lane] = ray.direction[axis];
-            }
-            fields[6][lane] = ray.t_min;
-            fields[7][lane] = ray.t_max;
-        }
-        const Lanes o[3] = {Lanes::load(fields[0]), Lanes::load(fields[1]), Lanes::load(fields[2])};
-        const Lanes d[3] = {Lanes::load(fields[3]), Lanes::load(fields[4]), Lanes::load(fields[5])};
-        const Lanes t_min = Lanes::load(fields[6]);
-        Lanes t_max = Lanes::load(fields[7]);
+        // Each ray's origin, direction, t_min and t_max, its first eight values, as a lane of
+        // each (simd::load_transposed); the lanes past count repeat ray 0.
+        static_assert(width == 8 && offsetof(Ray<Real>, t_max) == 7 * sizeof(Real));
+        const Real* rows[width];
+        for (int lane = 0; lane < width; ++lane) rows[lane] = reinterpret_cast<const Real*>(&rays[lane < count ? lane : 0]);
+        Lanes fields[width];
+        simd::load_transposed(rows, fields);
+        const Lanes o[3] = {fields[0], fields[1], fields[2]};
+        const Lanes d[3] = {fields[3], fields[4], fields[5]};
+        const Lanes t_min = fields[6];
+        Lanes t_max = fields[7];
+        alignas(64) Real limits[width];  // t_max's lanes, where a sphere hit lowers them
+        if constexpr (!AnyHit) t_max.store(limits);
         const Lanes zero = Lanes::broadcast(0);
         const auto dot = [](const Lanes* x, const Lanes* y) { return (x[0] * y[0] + x[1] * y[1]) + x[2] * y[2]; };
         const Lanes a = dot(d, d);  // glm::dot(direction, direction), as may_hit and the sphere test take it
@@ -243,8 +243,8 @@ public:
                     }
                 }
                 if constexpr (!AnyHit) {
-                    for (int i = 0; i < count; ++i) fields[7][i] = rays[i].t_max;
-                    t_max = Lanes::load(fields[7]);
+                    for (int i = 0; i < count; ++i) limits[i] = rays[i].t_max;
+                    t_max = Lanes::load(limits);
                 }
                 continue;
             }
@@ -295,14 +295,14 @@ public:
                 t.store(t_lanes);
                 for (; taken != 0; taken &= taken - 1) {
                     const int i = std::countr_zero(taken);
-                    rays[i].t_max = fields[7][i] = t_lanes[i];
+                    rays[i].t_max = limits[i] = t_lanes[i];
                     hits[i].t = t_lanes[i];
                     hits[i].primitive = 0;
                     hits[i].b1 = hits[i].b2 = 0;
                     hits[i].object = sphere.object;
                     found |= std::uint32_t(1) << i;
                 }
-                t_max = Lanes::load(fields[7]);
+                t_max = Lanes::load(limits);
             }
         }
     }

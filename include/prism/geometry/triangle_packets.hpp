@@ -151,19 +151,34 @@ public:
         // divisions give the same shear, bit for bit. Made one ray at a time through
         // Prepared, the set-up had cost as many instructions as the lanes' tests.
         RayLanes(const Ray<Real>* rays, int count) {
-            alignas(64) Storage fields[7][ray_lanes];
-            for (int lane = 0; lane < ray_lanes; ++lane) {
-                const Ray<Real>& ray = rays[lane < count ? lane : 0];
-                for (int axis = 0; axis < 3; ++axis) {
-                    fields[axis][lane] = Storage(ray.origin[axis]);
-                    fields[3 + axis][lane] = Storage(ray.direction[axis]);
+            // A ray's first eight values are its origin, direction, t_min and t_max, in that
+            // order: a lane's row of the transpose (simd::load_transposed).
+            static_assert(offsetof(Ray<Real>, direction) == 3 * sizeof(Real) && offsetof(Ray<Real>, t_min) == 6 * sizeof(Real) &&
+                          offsetof(Ray<Real>, t_max) == 7 * sizeof(Real) && sizeof(Ray<Real>) >= 8 * sizeof(Real));
+            LanePack fields[ray_lanes];
+            if constexpr (std::is_same_v<Storage, Real> && ray_lanes == 8) {
+                const Real* rows[ray_lanes];
+                for (int lane = 0; lane < ray_lanes; ++lane) rows[lane] = reinterpret_cast<const Real*>(&rays[lane < count ? lane : 0]);
+                simd::load_transposed(rows, fields);
+            } else {
+                alignas(64) Storage values[ray_lanes][8];
+                const Storage* rows[ray_lanes];
+                for (int lane = 0; lane < ray_lanes; ++lane) {
+                    const Ray<Real>& ray = rays[lane < count ? lane : 0];
+                    for (int axis = 0; axis < 3; ++axis) {
+                        values[lane][axis] = Storage(ray.origin[axis]);
+                        values[lane][3 + axis] = Storage(ray.direction[axis]);
+                    }
+                    values[lane][6] = Storage(ray.t_min);
+                    values[lane][7] = Storage(ray.t_max);
+                    rows[lane] = values[lane];
                 }
-                fields[6][lane] = Storage(ray.t_min);
+                simd::load_transposed(rows, fields);
             }
             const LanePack zero = LanePack::broadcast(0);
-            const LanePack origin[3] = {LanePack::load(fields[0]), LanePack::load(fields[1]), LanePack::load(fields[2])};
-            for (int axis = 0; axis < 3; ++axis) direction[axis] = LanePack::load(fields[3 + axis]);
-            t_min = LanePack::load(fields[6]);
+            const LanePack origin[3] = {fields[0], fields[1], fields[2]};
+            for (int axis = 0; axis < 3; ++axis) direction[axis] = fields[3 + axis];
+            t_min = fields[6];
             LanePack magnitude[3];
             for (int axis = 0; axis < 3; ++axis)
                 magnitude[axis] = select(direction[axis] < zero, -direction[axis], direction[axis]);
