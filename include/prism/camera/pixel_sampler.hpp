@@ -10,6 +10,7 @@
 #include <prism/scene/scene.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -28,13 +29,20 @@ template <class T>
 void shuffle(std::vector<T>& values, Random& random) {
     for (std::size_t i = values.size(); i > 1; --i) std::swap(values[i - 1], values[random.below(std::uint32_t(i))]);
 }
+// The stream outputs shuffle takes for n values: one below() each from n down to 2.
+inline std::uint64_t shuffle_outputs(int n) { return n > 1 ? std::uint64_t(n - 1) : 0; }
+
+// The side of stratified_2d's grid for n points, or 0 where n is not a square (n-rooks).
+inline int grid_side(int n) {
+    const int side = int(std::lround(std::sqrt(double(n))));
+    return side * side == n ? side : 0;
+}
 
 // n stratified points of [0, 1)^2: jittered grid for square n, n-rooks otherwise.
 template <Scalar Real>
 void stratified_2d(int n, Random& random, std::vector<Vec2<Real>>& points) {
     points.resize(std::size_t(n));
-    const int side = int(std::lround(std::sqrt(double(n))));
-    if (side * side == n) {
+    if (const int side = grid_side(n); side != 0) {
         for (int j = 0; j < side; ++j)
             for (int i = 0; i < side; ++i) {
                 const Vec2<Real> jitter = random.uniform2<Real>();
@@ -49,6 +57,12 @@ void stratified_2d(int n, Random& random, std::vector<Vec2<Real>>& points) {
         const Vec2<Real> jitter = random.uniform2<Real>();
         points[std::size_t(i)] = (Vec2<Real>(Real(i), Real(columns[std::size_t(i)])) + jitter) / Real(n);
     }
+}
+// The stream outputs stratified_2d takes for n points: two uniforms a point, and n-rooks'
+// shuffle of its columns.
+template <Scalar Real>
+std::uint64_t stratified_2d_outputs(int n) {
+    return 2 * std::uint64_t(n) * std::uint64_t(Random::outputs_per_uniform<Real>) + (grid_side(n) != 0 ? 0 : shuffle_outputs(n));
 }
 
 }  // namespace detail
@@ -107,8 +121,6 @@ void camera_samples(int count, Random& random, std::vector<CameraSample<Real>>& 
         samples[0] = centre_sample<Real>(random);
         return;
     }
-    const std::uint64_t n = std::uint64_t(count), per_uniform = std::uint64_t(Random::outputs_per_uniform<Real>);
-    const std::uint64_t shuffle_draws = n - 1;  // one below() each, from n down to 2
     detail::stratified_2d(count, random, scratch);
     for (int i = 0; i < count; ++i) samples[std::size_t(i)].pixel = scratch[std::size_t(i)];
     if (reads.lens) {
@@ -116,9 +128,7 @@ void camera_samples(int count, Random& random, std::vector<CameraSample<Real>>& 
         detail::shuffle(scratch, random);
         for (int i = 0; i < count; ++i) samples[std::size_t(i)].lens = scratch[std::size_t(i)];
     } else {
-        const std::uint64_t side = std::uint64_t(std::lround(std::sqrt(double(count))));
-        const std::uint64_t grid_draws = 2 * n * per_uniform + (side * side == n ? 0 : shuffle_draws);
-        random.advance(grid_draws + shuffle_draws);
+        random.advance(detail::stratified_2d_outputs<Real>(count) + detail::shuffle_outputs(count));
         for (int i = 0; i < count; ++i) samples[std::size_t(i)].lens = Vec2<Real>(Real(0.5));
     }
     // Time: one jittered stratum per sample, shuffled.
@@ -127,7 +137,7 @@ void camera_samples(int count, Random& random, std::vector<CameraSample<Real>>& 
         for (std::size_t i = std::size_t(count); i > 1; --i) std::swap(scratch[i - 1].x, scratch[random.below(std::uint32_t(i))].x);
         for (int i = 0; i < count; ++i) samples[std::size_t(i)].time = scratch[std::size_t(i)].x;
     } else {
-        random.advance(n * per_uniform + shuffle_draws);
+        random.advance(std::uint64_t(count) * std::uint64_t(Random::outputs_per_uniform<Real>) + detail::shuffle_outputs(count));
         for (int i = 0; i < count; ++i) samples[std::size_t(i)].time = Real(0);
     }
 }
