@@ -14,6 +14,7 @@
 #include <prism/geometry/aabb.hpp>
 #include <prism/geometry/hit.hpp>
 #include <prism/geometry/placement.hpp>
+#include <prism/geometry/ray_lanes.hpp>
 #include <prism/geometry/sphere.hpp>
 #include <prism/scene/scene.hpp>
 #include <prism/simd/pack.hpp>
@@ -21,7 +22,6 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
-#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -191,13 +191,9 @@ public:
     template <bool AnyHit = false>
     void intersect_spheres_lanes(std::conditional_t<AnyHit, const Ray<Real>*, Ray<Real>*> rays, Hit<Real>* hits,
                                         int count, std::uint32_t& found) const {
-        // Each ray's origin, direction, t_min and t_max, its first eight values, as a lane of
-        // each (simd::load_transposed); the lanes past count repeat ray 0.
-        static_assert(width == 8 && offsetof(Ray<Real>, t_max) == 7 * sizeof(Real));
-        const Real* rows[width];
-        for (int lane = 0; lane < width; ++lane) rows[lane] = reinterpret_cast<const Real*>(&rays[lane < count ? lane : 0]);
+        static_assert(width == 8);
         Lanes fields[width];
-        simd::load_transposed(rows, fields);
+        rays_as_lanes(rays, count, fields);
         const Lanes o[3] = {fields[0], fields[1], fields[2]};
         const Lanes d[3] = {fields[3], fields[4], fields[5]};
         const Lanes t_min = fields[6];

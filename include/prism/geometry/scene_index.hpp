@@ -147,10 +147,10 @@ public:
     // Every route below tests every surface but the planes; the entry tests the planes last,
     // from the t_max the route leaves (where each route had tested them, so the same hits).
     // Only BackfaceCulling::all culls planes, and triangles cull under both rules that cull
-    // (culls_planes, culls_back_faces). Both are run-time choices: the routes take the triangles' as `cull`, which the leaf
-    // tests read only where a triangle is hit, and the planes take theirs here. Compiled for
-    // each rule, every route was two or three copies: each copy an eighth of the prism
-    // binary's code.
+    // (culls_planes, culls_back_faces). Both are run-time choices: the routes take the
+    // triangles' as `cull`, which the leaf tests read only where a triangle is hit, and the
+    // planes take theirs here. Compiled for each rule, every route was two or three copies:
+    // each copy an eighth of the prism binary's code.
     PRISM_FORCE_INLINE std::uint32_t intersect(const RayBatch<Real>& batch, Hit<Real>* hits) const {
         if (batch.count == 1) {
             if (!(batch.active & 1)) return 0;

@@ -11,6 +11,7 @@
 #include <prism/math/force_inline.hpp>
 #include <prism/geometry/double_refine.hpp>
 #include <prism/geometry/hit.hpp>
+#include <prism/geometry/ray_lanes.hpp>
 #include <prism/geometry/watertight.hpp>
 #include <prism/memory/huge_page_allocator.hpp>
 #include <prism/parallel/for_each_run.hpp>
@@ -151,30 +152,10 @@ public:
         // divisions give the same shear, bit for bit. Made one ray at a time through
         // Prepared, the set-up had cost as many instructions as the lanes' tests.
         RayLanes(const Ray<Real>* rays, int count) {
-            // A ray's first eight values are its origin, direction, t_min and t_max, in that
-            // order: a lane's row of the transpose (simd::load_transposed).
-            static_assert(offsetof(Ray<Real>, direction) == 3 * sizeof(Real) && offsetof(Ray<Real>, t_min) == 6 * sizeof(Real) &&
-                          offsetof(Ray<Real>, t_max) == 7 * sizeof(Real) && sizeof(Ray<Real>) >= 8 * sizeof(Real));
+            // Only Watertight's packets test ray lanes, and they store Real (tests_ray_lanes).
+            static_assert(std::is_same_v<Storage, Real> && ray_lanes == 8);
             LanePack fields[ray_lanes];
-            if constexpr (std::is_same_v<Storage, Real> && ray_lanes == 8) {
-                const Real* rows[ray_lanes];
-                for (int lane = 0; lane < ray_lanes; ++lane) rows[lane] = reinterpret_cast<const Real*>(&rays[lane < count ? lane : 0]);
-                simd::load_transposed(rows, fields);
-            } else {
-                alignas(64) Storage values[ray_lanes][8];
-                const Storage* rows[ray_lanes];
-                for (int lane = 0; lane < ray_lanes; ++lane) {
-                    const Ray<Real>& ray = rays[lane < count ? lane : 0];
-                    for (int axis = 0; axis < 3; ++axis) {
-                        values[lane][axis] = Storage(ray.origin[axis]);
-                        values[lane][3 + axis] = Storage(ray.direction[axis]);
-                    }
-                    values[lane][6] = Storage(ray.t_min);
-                    values[lane][7] = Storage(ray.t_max);
-                    rows[lane] = values[lane];
-                }
-                simd::load_transposed(rows, fields);
-            }
+            rays_as_lanes(rays, count, fields);
             const LanePack zero = LanePack::broadcast(0);
             const LanePack origin[3] = {fields[0], fields[1], fields[2]};
             for (int axis = 0; axis < 3; ++axis) direction[axis] = fields[3 + axis];

@@ -270,8 +270,8 @@ void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment, Sampler
     const std::uint32_t met = geometry_.intersect(RayBatch<Real>::all(reflections.data(), reflected_count), reflection_hits.data());
     std::array<Vec3<Real>, row_width> traced;
     if (depth + 1 < row_depth) {
-        shade_row(reflections.data(), reflection_hits.data(), met, reflected_count, reflection_paths.data(),
-                         reached.data(), depth + 1, traced.data());
+        shade_row(reflections.data(), reflection_hits.data(), met, reflected_count, reflection_paths.data(), reached.data(),
+                  depth + 1, traced.data());
     } else {
         for (int j = 0; j < reflected_count; ++j) {
             const Ray<Real>& reflection = reflections[std::size_t(j)];

@@ -265,7 +265,6 @@ PRISM_SIMD_INLINE inline Pack<T, N> sqrt(Pack<T, N> a) {
 #endif
 }
 
-
 // N rows of N values, each row where rows[i] points, as N packs: columns[j]'s lane i is
 // rows[i][j] (the rays of a row of lanes, each stored whole, as the lanes' origins, directions
 // and bounds). Filled lane by lane through memory, a pack is loaded from N stores made just
