@@ -3,8 +3,9 @@
 # order rotated from round to round, so that a shared machine's load and drift fall on all of
 # them alike. Each binary's time is taken over the first binary's of the same round; the medians
 # and ranges of those ratios are what bench/RESULTS.md records ("Whole renders", "Path tracer").
-# Every render's images are compared, byte for byte, with the first binary's of its round: a
-# binary that wrote other pixels is reported, since a ratio between different images means little.
+# Every render's images are compared with the first binary's of its round (bench/same_pixels.py:
+# the same bytes, or the same pixels decoded): a binary that wrote other pixels is reported,
+# since a ratio between different images means little.
 #
 #   bash bench/paired.sh ROUNDS SCENE LABEL=PRISM [LABEL=PRISM]... [-- PRISM_OPTIONS...]
 #
@@ -54,7 +55,8 @@ for ((round = 0; round < rounds; ++round)); do
   for ((k = 1; k < count; ++k)); do
     same=1
     for image in "$work/out_0"/*; do
-      cmp -s "$image" "$work/out_$k/$(basename "$image")" || same=0
+      [[ -f $work/out_$k/$(basename "$image") ]] &&
+        python3 "$(dirname "$0")/same_pixels.py" "$image" "$work/out_$k/$(basename "$image")" || same=0
     done
     [[ $(ls "$work/out_0" | wc -l) == $(ls "$work/out_$k" | wc -l) ]] || same=0
     echo "$round $k $same" >> "$work/same"

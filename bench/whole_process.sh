@@ -55,43 +55,11 @@ run() {  # binary, output folder, scene, options...: prints seconds, or "refused
     echo refused
   fi
 }
-# Whether two image files hold the same pixels: PNGs are decoded (8-bit, non-interlaced; the
-# two binaries may compress differently), other files compared byte for byte.
+# Whether two image files hold the same pixels (bench/same_pixels.py: PNGs and EXRs are
+# decoded, as the two binaries may compress the same pixels differently).
 same_pixels() {
   [[ -f $2 ]] || return 1
-  [[ $1 == *.png ]] || { cmp -s "$1" "$2"; return; }
-  python3 - "$1" "$2" <<'EOF'
-import struct, sys, zlib
-def pixels(path):
-    data = open(path, 'rb').read()
-    at, idat = 8, b''
-    while at < len(data):
-        size, kind = struct.unpack('>I4s', data[at:at + 8])
-        body = data[at + 8:at + 8 + size]
-        if kind == b'IHDR':
-            width, height, depth, colour = struct.unpack('>IIBB', body[:10])
-            channels = {0: 1, 2: 3, 4: 2, 6: 4}[colour]
-        elif kind == b'IDAT':
-            idat += body
-        at += 12 + size
-    raw, stride, rows, previous = zlib.decompress(idat), width * channels, [], bytearray(width * channels)
-    for y in range(height):
-        kind, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
-        for i in range(stride):
-            a = line[i - channels] if i >= channels else 0
-            b, c = previous[i], previous[i - channels] if i >= channels else 0
-            if kind == 1: line[i] = (line[i] + a) & 255
-            elif kind == 2: line[i] = (line[i] + b) & 255
-            elif kind == 3: line[i] = (line[i] + (a + b) // 2) & 255
-            elif kind == 4:
-                p = a + b - c
-                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-        rows.append(bytes(line))
-        previous = line
-    return depth, channels, rows
-sys.exit(0 if pixels(sys.argv[1]) == pixels(sys.argv[2]) else 1)
-EOF
+  python3 "$(dirname "$0")/same_pixels.py" "$1" "$2"
 }
 median() { sort -g | awk '{ a[NR] = $1 } END { print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2 }'; }
 

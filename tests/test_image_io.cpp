@@ -218,6 +218,74 @@ TEST_CASE("EXR round trip is bit-identical, in B,G,R channel order") {
     FreeEXRHeader(&header);
 }
 
+namespace {
+
+// Bits of every kind a float can hold, from a 32-bit LCG's high bits: NaNs with payloads,
+// infinities, subnormals, -0; incompressible, so deflate cannot shrink their blocks.
+prism::Image random_bits_image(int width, int height, std::uint32_t state) {
+    prism::Image image(width, height);
+    for (auto& pixel : image.pixels)
+        for (int c = 0; c < 3; ++c) {
+            std::uint32_t bits = 0;
+            for (int half = 0; half < 2; ++half) {
+                state = state * 1664525u + 1013904223u;
+                bits = (bits << 16) | (state >> 16);
+            }
+            std::memcpy(&pixel[c], &bits, sizeof(float));
+        }
+    return image;
+}
+
+std::size_t bit_mismatches(const prism::Image& a, const prism::Image& b) {
+    if (a.width != b.width || a.height != b.height) return std::size_t(-1);
+    std::size_t mismatches = 0;
+    for (std::size_t i = 0; i < a.pixels.size(); ++i)
+        for (int c = 0; c < 3; ++c)
+            if (std::memcmp(&a.pixels[i][c], &b.pixels[i][c], sizeof(float)) != 0) ++mismatches;
+    return mismatches;
+}
+
+}  // namespace
+
+TEST_CASE("encode_exr: tinyexr reads back every float's bits, from the same bytes at 1 and 2 threads") {
+    ScratchFolder folder("exr_blocks");
+    // Heights around the 16-row block (a short last block, a single row); widths of one pixel
+    // and of an odd number.
+    const std::pair<int, int> sizes[] = {{1, 1}, {1, 40}, {601, 16}, {33, 17}, {601, 500}, {7, 15}};
+    for (const auto& size : sizes) {
+        const int width = size.first, height = size.second;
+        for (bool noise : {false, true}) {
+            CAPTURE(width);
+            CAPTURE(height);
+            CAPTURE(noise);
+            // Renders' values (smooth and rounded, which deflate shrinks) or random bits (which it
+            // cannot: those blocks are stored as they are).
+            const prism::Image image = noise ? random_bits_image(width, height, 99u + std::uint32_t(width))
+                                             : noise_image(width, height, 7u + std::uint32_t(height));
+            std::vector<std::vector<std::uint8_t>> files;
+            for (int threads : {1, 2}) {
+                const tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+                const auto file = prism::encode_exr(image);
+                REQUIRE(file.has_value());
+                files.push_back(*file);
+            }
+            CHECK(files[0] == files[1]);
+            const std::size_t raw_bytes = image.pixels.size() * 12;
+            // Random bits are stored as they are, behind the header and the offsets; noise_image
+            // repeats its 4,096 values, which deflate shrinks where there are many pixels.
+            if (noise) CHECK(files[0].size() > raw_bytes);
+            else if (raw_bytes > 8192) CHECK(files[0].size() < raw_bytes);
+            const fs::path path = folder.path / "blocks.exr";
+            prism::write_image(path, image);
+            std::ifstream stream(path, std::ios::binary);
+            const std::vector<std::uint8_t> written((std::istreambuf_iterator<char>(stream)),
+                                                   std::istreambuf_iterator<char>());
+            CHECK(written == files[0]);
+            CHECK(bit_mismatches(prism::read_image(path), image) == 0);
+        }
+    }
+}
+
 TEST_CASE("the shared environment maps read: tiled and scanline EXR, Radiance HDR") {
     if (!fs::is_directory(fs::path(PRISM_SHARED_DIR) / "envmaps")) {
         MESSAGE("skipped: " PRISM_SHARED_DIR "/envmaps not found");

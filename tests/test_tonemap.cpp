@@ -6,8 +6,11 @@
 #include <prism/image/tonemap.hpp>
 
 #include <doctest/doctest.h>
+#include <tbb/global_control.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <string>
@@ -146,6 +149,38 @@ TEST_CASE_TEMPLATE("black, broken and empty images", Real, float, double) {
     CHECK(with_nan.pixels[0] == glm::vec3(0.0f));
     CHECK(with_nan.pixels[1] == mapped.pixels[1]);
     CHECK(prism::tone_map<Real>(Image{}, photographic(0.18, 1)).pixels.empty());
+}
+
+TEST_CASE_TEMPLATE("a tone map is the same image at 1 and 2 threads, for every curve", Real, float, double) {
+    // 700 x 300: more than two of tone_map_grain's runs, so two threads share every pass.
+    Image hdr(700, 300);
+    REQUIRE(hdr.pixels.size() > 4 * prism::tone_map_grain);
+    std::uint32_t state = 2024u;
+    for (auto& pixel : hdr.pixels)
+        for (int c = 0; c < 3; ++c) {
+            state = state * 1664525u + 1013904223u;
+            pixel[c] = std::ldexp(float(state >> 8), -20) * float(1 + (state & 7));  // 0 to ~128
+        }
+    hdr.pixels[5] = glm::vec3(-1.0f, std::numeric_limits<float>::quiet_NaN(), 2.0f);  // a broken pixel
+    for (const TonemapOperator tone_operator :
+         {TonemapOperator::photographic, TonemapOperator::aces, TonemapOperator::filmic}) {
+        for (const double saturation : {1.0, 0.6}) {
+            Tonemap settings;
+            settings.tone_operator = tone_operator;
+            settings.key = 0.18;
+            settings.burn_percent = 1;
+            settings.saturation = saturation;
+            settings.gamma = 2.2;
+            std::vector<Image> images;
+            for (int threads : {1, 2}) {
+                const tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+                images.push_back(prism::tone_map<Real>(hdr, settings));
+            }
+            CAPTURE(saturation);
+            CHECK(std::memcmp(images[0].pixels.data(), images[1].pixels.data(), images[0].pixels.size() * sizeof(glm::vec3)) == 0);
+            CHECK(images[0].pixels[5] == glm::vec3(0.0f, 0.0f, 0.0f));
+        }
+    }
 }
 
 TEST_CASE_TEMPLATE("ACES: Narkowicz's fitted curve", Real, float, double) {

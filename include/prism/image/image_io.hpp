@@ -1,9 +1,11 @@
-// Image files: the course's 8-bit conversion, writing PNG, PPM and EXR, reading PNG/JPG/BMP/TGA/PPM,
-// Radiance .hdr and OpenEXR (scanline or tiled) into the HDR film. stb and tinyexr are compiled
-// in their system libraries (libstb, libtinyexr), so no *_IMPLEMENTATION macro is defined here.
+// Image files: the course's 8-bit conversion, writing PNG, PPM and EXR (prism's own encoders,
+// png_encoder.hpp and exr_encoder.hpp), reading PNG/JPG/BMP/TGA/PPM, Radiance .hdr and OpenEXR
+// (scanline or tiled) into the HDR film. stb and tinyexr, the readers, are compiled in their
+// system libraries (libstb, libtinyexr), so no *_IMPLEMENTATION macro is defined here.
 #pragma once
 
 #include <prism/image/decoder_guard.hpp>
+#include <prism/image/exr_encoder.hpp>
 #include <prism/image/image.hpp>
 #include <prism/image/png_encoder.hpp>
 #include <prism/image/texels.hpp>
@@ -66,51 +68,6 @@ inline std::filesystem::path temporary_sibling(const std::filesystem::path& path
     return temporary;
 }
 
-// Float RGB written as three FLOAT channels named B, G, R: EXR viewers expect the channels sorted
-// by name, and tinyexr's own SaveEXR does the same. ZIP compression is lossless, so a float
-// written is the float read back, bit for bit.
-inline void write_exr(const std::filesystem::path& path, const Image& image, const std::filesystem::path& shown) {
-    const std::size_t count = image.pixels.size();
-    std::vector<float> red(count), green(count), blue(count);
-    for (std::size_t i = 0; i < count; ++i) {
-        red[i] = image.pixels[i].r;
-        green[i] = image.pixels[i].g;
-        blue[i] = image.pixels[i].b;
-    }
-    float* planes[3] = {blue.data(), green.data(), red.data()};
-
-    EXRImage exr_image;
-    InitEXRImage(&exr_image);
-    exr_image.num_channels = 3;
-    exr_image.images = reinterpret_cast<unsigned char**>(planes);
-    exr_image.width = image.width;
-    exr_image.height = image.height;
-
-    // The header's arrays live on this stack frame, so no FreeEXRHeader: nothing leaks on any path.
-    EXRChannelInfo channels[3] = {};
-    const char names[3] = {'B', 'G', 'R'};
-    for (int c = 0; c < 3; ++c) {
-        channels[c].name[0] = names[c];
-        channels[c].x_sampling = channels[c].y_sampling = 1;
-    }
-    int pixel_types[3] = {TINYEXR_PIXELTYPE_FLOAT, TINYEXR_PIXELTYPE_FLOAT, TINYEXR_PIXELTYPE_FLOAT};
-    int requested_pixel_types[3] = {TINYEXR_PIXELTYPE_FLOAT, TINYEXR_PIXELTYPE_FLOAT, TINYEXR_PIXELTYPE_FLOAT};
-    EXRHeader header;
-    InitEXRHeader(&header);
-    header.num_channels = 3;
-    header.channels = channels;
-    header.pixel_types = pixel_types;
-    header.requested_pixel_types = requested_pixel_types;
-    header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
-
-    const char* error = nullptr;
-    if (SaveEXRImageToFile(&exr_image, &header, path.c_str(), &error) != TINYEXR_SUCCESS) {
-        const std::string message = error ? error : "cannot write the EXR file";
-        if (error) FreeEXRErrorMessage(error);
-        throw io::LoadError(shown, "ImageName", message);
-    }
-}
-
 inline std::string stb_failure() {
     const char* reason = stbi_failure_reason();
     return reason ? reason : "unknown reason";
@@ -139,9 +96,8 @@ inline void write_ppm(const std::filesystem::path& path, const Image& image, con
     if (!out) throw io::LoadError(shown, "ImageName", "cannot write the PPM file");
 }
 
-// The PNG (png_encoder.hpp) written whole.
-inline bool write_png(const std::filesystem::path& path, const Image& image) {
-    const std::optional<std::vector<std::uint8_t>> file = encode_png(image);
+// A file encoded whole (png_encoder.hpp, exr_encoder.hpp), written out.
+inline bool write_encoded(const std::filesystem::path& path, const std::optional<std::vector<std::uint8_t>>& file) {
     if (!file) return false;
     std::ofstream out(path, std::ios::binary);
     out.write(reinterpret_cast<const char*>(file->data()), std::streamsize(file->size()));
@@ -171,12 +127,13 @@ inline void write_image(const std::filesystem::path& path, const Image& image) {
     const std::filesystem::path temporary = detail::temporary_sibling(path);
     try {
         if (extension == ".png") {
-            if (!detail::write_png(temporary, image))
+            if (!detail::write_encoded(temporary, encode_png(image)))
                 throw io::LoadError(path, "ImageName", "cannot write the PNG file");
         } else if (extension == ".ppm") {
             detail::write_ppm(temporary, image, path);
         } else {
-            detail::write_exr(temporary, image, path);
+            if (!detail::write_encoded(temporary, encode_exr(image)))
+                throw io::LoadError(path, "ImageName", "cannot write the EXR file");
         }
         std::filesystem::rename(temporary, path, error);
         if (error) throw io::LoadError(path, "ImageName", "cannot replace the file: " + error.message());

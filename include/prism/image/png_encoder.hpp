@@ -8,6 +8,7 @@
 // fixed, so the file's bytes do not depend on the number of threads.
 #pragma once
 
+#include <prism/image/deflate_stream.hpp>
 #include <prism/image/image.hpp>
 
 #include <tbb/blocked_range.h>
@@ -53,22 +54,13 @@ struct DeflatedBand {
     bool ok = false;
 };
 
-// A thread's buffers and deflate state, kept from band to band: a fresh z_stream allocates and
-// clears about 260 kB, and fresh buffers are cleared and faulted in again, which took a third of
-// the encoding of hw1 simple.xml's image.
+// A thread's buffers and deflate state, kept from band to band: fresh buffers are cleared and
+// faulted in again, as a fresh z_stream is (deflate_stream.hpp).
 struct BandScratch {
     std::vector<std::uint8_t> row;  // a row's bytes before filtering
     std::vector<std::uint8_t> filtered;
     std::vector<std::uint8_t> deflated;
-    z_stream stream{};
-    bool ready = false;
-
-    BandScratch() { ready = deflateInit2(&stream, png_deflate_level, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY) == Z_OK; }
-    ~BandScratch() {
-        if (ready) deflateEnd(&stream);
-    }
-    BandScratch(const BandScratch&) = delete;
-    BandScratch& operator=(const BandScratch&) = delete;
+    DeflateStream stream{png_deflate_level, -15};
 };
 
 // Rows [first, last) of `image`, converted, filtered with Sub (each byte minus the byte one
@@ -76,7 +68,6 @@ struct BandScratch {
 inline DeflatedBand deflate_band(const Image& image, int first, int last) {
     thread_local BandScratch scratch;
     DeflatedBand band;
-    if (!scratch.ready || deflateReset(&scratch.stream) != Z_OK) return band;
     const std::size_t row = std::size_t(image.width) * 3;
     std::vector<std::uint8_t>& filtered = scratch.filtered;
     filtered.resize((row + 1) * std::size_t(last - first));
@@ -98,17 +89,9 @@ inline DeflatedBand deflate_band(const Image& image, int first, int last) {
     }
     band.size = filtered.size();
     band.adler = adler32(adler32(0L, Z_NULL, 0), filtered.data(), uInt(filtered.size()));
-    z_stream& stream = scratch.stream;
-    // deflateBound covers a finished stream; a sync flush adds at most an empty stored block.
-    scratch.deflated.resize(deflateBound(&stream, uLong(filtered.size())) + 16);
-    stream.next_in = filtered.data();
-    stream.avail_in = uInt(filtered.size());
-    stream.next_out = scratch.deflated.data();
-    stream.avail_out = uInt(scratch.deflated.size());
-    const bool final_band = last == image.height;
-    const int result = deflate(&stream, final_band ? Z_FINISH : Z_SYNC_FLUSH);
-    band.ok = final_band ? result == Z_STREAM_END : (result == Z_OK && stream.avail_in == 0 && stream.avail_out > 0);
-    band.bytes.assign(scratch.deflated.data(), scratch.deflated.data() + (scratch.deflated.size() - stream.avail_out));
+    band.ok = scratch.stream.deflate_all(filtered.data(), filtered.size(), last == image.height ? Z_FINISH : Z_SYNC_FLUSH,
+                                         scratch.deflated);
+    band.bytes = scratch.deflated;
     return band;
 }
 
