@@ -5,9 +5,9 @@
 // for bit, NaN payloads and -0 included.
 //
 // Why not tinyexr's SaveEXR, which the reader still uses: it deflates the blocks one after
-// another at zlib's default level, and a 512 x 512 film took it 86 ms (640 x 480: 150 ms) on
-// the main thread after the render, 7% of hw7 path_diffuse's whole process at 16 samples a pixel
-// (eight cameras, an EXR each). The blocks are independent streams, so they deflate on TBB's
+// another at zlib's default level, and a 512 x 512 film took it 80-160 ms on the main thread
+// after the render, 7% of hw7 path_diffuse's whole process at 16 samples a pixel (eight
+// cameras, an EXR each). The blocks are independent streams, so they deflate on TBB's
 // threads here, at zlib's fastest level, as the PNG bands do (png_encoder.hpp). The block
 // layout is fixed, so the file's bytes do not depend on the number of threads.
 #pragma once
@@ -22,7 +22,6 @@
 #include <bit>
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
 #include <optional>
 #include <string_view>
 #include <vector>
@@ -34,11 +33,11 @@ namespace detail {
 // Scanlines per block of ZIP_COMPRESSION (OpenEXR's ImfCompression.h): the format fixes it.
 inline constexpr int exr_block_rows = 16;
 
-// zlib's fastest level, as for the PNG bands. On one core, against tinyexr's default level: a
-// noisy path-traced film (hw7 path_diffuse, 16 samples a pixel) 0.84 of its time, a ray-traced
-// one (hw5 cube_point_hdr) 0.66, a photographed environment map 0.27, for files 1.00-1.12
-// times as large (bench/RESULTS.md, "Writing the images"). Run-length or Huffman-only coding
-// was faster still on the noisy film (0.35), but left the smooth ones 1.8-3.1 times as large.
+// zlib's fastest level, as for the PNG bands. On one core it takes 0.26-0.30 of tinyexr's time
+// (the default level) on the course's path-traced references and a photographed environment
+// map, for files 1.05-1.12 times as large (bench/image_write_bench.cpp; bench/RESULTS.md,
+// "Writing the images"). Run-length or Huffman-only coding was faster still on a noisy
+// 16-sample film, but left smooth ones 1.8-3.1 times as large.
 inline constexpr int exr_deflate_level = Z_BEST_SPEED;
 
 // The film's floats are copied to the file as they lie in memory; EXR stores little-endian.
