@@ -81,7 +81,8 @@ Real filmic_curve(Real x) {
 // Pixels per run of the tone map's passes on TBB's threads (for_each_run): 192 kB of film, so
 // a course image of 512 x 512 or more is split between two threads. Each pixel's value is
 // worked out alone, so the image is the same for any number of threads. On the main thread
-// after the render, the passes took 34 ms of each 512 x 512 camera of hw7 path_diffuse.
+// alone, a tone map and its PNG had taken 34 ms of each 512 x 512 camera of hw7 path_diffuse,
+// after the render (bench/RESULTS.md, "Writing the images").
 inline constexpr std::size_t tone_map_grain = std::size_t(1) << 14;
 
 // Luminance of each pixel; a negative or non-finite one (a broken pixel) counts as black, so it
