@@ -30,7 +30,7 @@ struct ShadingRow {
 // computing the scalar code's operations in its order: the same directions, radiances,
 // cosines and rays, bit for bit. The lit lanes are those the scalar `cos <= 0` test lets
 // through (NaN included); returns them, whose rays are made. The square roots and
-// divisions of sixteen points then share vector instructions (hw2 mirror_room: 0.88 of
+// divisions of eight points (four in double) then share vector instructions (hw2 mirror_room: 0.88 of
 // the wall time with the rays made point by point).
 // `epsilon`: where rays leave by the scene's epsilon, the origins are made here, lane by lane as
 // leaving_ray makes them (the point moved by epsilon along the normal, to the side the ray
@@ -41,7 +41,12 @@ std::uint32_t point_light_lanes(const PointLight<Real>& light, const ShadingRow<
                                 const std::optional<Real>& epsilon, std::array<Vec3<Real>, RowWidth>& directions,
                                 std::array<Vec3<Real>, RowWidth>& radiances, std::array<Real, RowWidth>& cosines,
                                 Unconstructed<Ray<Real>, RowWidth>& shadows, OriginOf origin_of) {
-    constexpr int width = sizeof(Real) == 4 ? 16 : 8;
+    // One 32-byte register's lanes at a time (8 floats, 4 doubles), as LightMesh::view_weights
+    // takes them: with 64-byte lanes (16 floats) the square roots and divisions were 512-bit
+    // instructions, and hw4 perlin_types_nobump, glass_plates_point and hw2 mirror_room took
+    // 1.08, 1.06 and 1.06 times as long on the Intel VM, the same images (bench/RESULTS.md,
+    // "Whole renders against the baselines").
+    constexpr int width = int(32 / sizeof(Real));
     static_assert(int(RowWidth) % width == 0);
     using Lanes = simd::Pack<Real, width>;
     std::uint32_t lit = 0;
