@@ -42,10 +42,12 @@ std::uint32_t point_light_lanes(const PointLight<Real>& light, const ShadingRow<
                                 std::array<Vec3<Real>, RowWidth>& radiances, std::array<Real, RowWidth>& cosines,
                                 Unconstructed<Ray<Real>, RowWidth>& shadows, OriginOf origin_of) {
     // One 32-byte register's lanes at a time (8 floats, 4 doubles), as LightMesh::view_weights
-    // takes them: with 64-byte lanes (16 floats) the square roots and divisions were 512-bit
-    // instructions, and hw4 perlin_types_nobump, glass_plates_point and hw2 mirror_room took
-    // 1.08, 1.06 and 1.06 times as long on the Intel VM, the same images (bench/RESULTS.md,
-    // "Whole renders against the baselines").
+    // takes them: in 64-byte lanes (16 floats) hw4 perlin_types_nobump, glass_plates_point and
+    // hw2 mirror_room took 1.08, 1.06 and 1.06 times as long on the Intel VM, the same images.
+    // Not for the divisions' width alone (two 256-bit divisions for each 512-bit one changed
+    // nothing elsewhere); with 32-byte lanes a float render with watertight tests runs no
+    // 512-bit floating-point instruction at all (bench/RESULTS.md, "Stalls and draws nobody
+    // reads").
     constexpr int width = int(32 / sizeof(Real));
     static_assert(int(RowWidth) % width == 0);
     using Lanes = simd::Pack<Real, width>;
