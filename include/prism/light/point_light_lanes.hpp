@@ -44,10 +44,9 @@ std::uint32_t point_light_lanes(const PointLight<Real>& light, const ShadingRow<
     // One 32-byte register's lanes at a time (8 floats, 4 doubles), as LightMesh::view_weights
     // takes them: in 64-byte lanes (16 floats) hw4 perlin_types_nobump, glass_plates_point and
     // hw2 mirror_room took 1.08, 1.06 and 1.06 times as long on the Intel VM, the same images.
-    // Not for the divisions' width alone (two 256-bit divisions for each 512-bit one changed
-    // nothing elsewhere); with 32-byte lanes a float render with watertight tests runs no
-    // 512-bit floating-point instruction at all (bench/RESULTS.md, "Stalls and draws nobody
-    // reads").
+    // Why is not settled: neither two 256-bit divisions for each 512-bit one nor the
+    // double-refine packets in 256-bit halves changed anything elsewhere (bench/RESULTS.md,
+    // "Stalls and draws nobody reads").
     constexpr int width = int(32 / sizeof(Real));
     static_assert(int(RowWidth) % width == 0);
     using Lanes = simd::Pack<Real, width>;
