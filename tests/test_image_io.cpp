@@ -15,6 +15,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -76,6 +77,25 @@ prism::Image noise_image(int width, int height, std::uint32_t state) {
     return image;
 }
 
+// A file's bytes, as written.
+std::vector<std::uint8_t> file_bytes(const fs::path& path) {
+    std::ifstream stream(path, std::ios::binary);
+    return std::vector<std::uint8_t>((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+}
+
+// An encoder's file of `image` at 1 and at 2 threads (encode: encode_png or encode_exr).
+template <class Encode>
+std::vector<std::vector<std::uint8_t>> encoded_at_1_and_2_threads(const prism::Image& image, Encode encode) {
+    std::vector<std::vector<std::uint8_t>> files;
+    for (int threads : {1, 2}) {
+        const tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+        const std::optional<std::vector<std::uint8_t>> file = encode(image);
+        REQUIRE(file.has_value());
+        files.push_back(*file);
+    }
+    return files;
+}
+
 }  // namespace
 
 TEST_CASE("to_8bit clamps to 0..255 and truncates, as the course does") {
@@ -135,8 +155,7 @@ TEST_CASE("a PPM of many row blocks and a PNG decoded in runs hold the to_8bit v
     ScratchFolder folder("blocks");
     const fs::path ppm = folder.path / "blocks.ppm";
     prism::write_image(ppm, image);
-    std::ifstream stream(ppm, std::ios::binary);
-    const std::vector<std::uint8_t> written((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+    const std::vector<std::uint8_t> written = file_bytes(ppm);
     const std::string header = "P6\n1024 768\n255\n";
     REQUIRE(written.size() == header.size() + expected.size());
     CHECK(std::equal(header.begin(), header.end(), written.begin()));
@@ -161,20 +180,12 @@ TEST_CASE("a PNG of many bands decodes to the to_8bit values, in the same bytes 
     // last one short.
     const prism::Image image = noise_image(601, 500, 12345u);
     REQUIRE(prism::detail::png_band_rows(601 * 3) < image.height / 4);
-    std::vector<std::vector<std::uint8_t>> files;
-    for (int threads : {1, 2}) {
-        const tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
-        const auto file = prism::encode_png(image);
-        REQUIRE(file.has_value());
-        files.push_back(*file);
-    }
+    const auto files = encoded_at_1_and_2_threads(image, [](const prism::Image& i) { return prism::encode_png(i); });
     CHECK(files[0] == files[1]);
     ScratchFolder folder("bands");
     const fs::path path = folder.path / "bands.png";
     prism::write_image(path, image);
-    std::ifstream stream(path, std::ios::binary);
-    const std::vector<std::uint8_t> written((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
-    CHECK(written == files[0]);
+    CHECK(file_bytes(path) == files[0]);
     const prism::Image read = prism::read_image(path);
     REQUIRE(read.width == image.width);
     REQUIRE(read.height == image.height);
@@ -262,13 +273,8 @@ TEST_CASE("encode_exr: tinyexr reads back every float's bits, from the same byte
             // cannot: those blocks are stored as they are).
             const prism::Image image = noise ? random_bits_image(width, height, 99u + std::uint32_t(width))
                                              : noise_image(width, height, 7u + std::uint32_t(height));
-            std::vector<std::vector<std::uint8_t>> files;
-            for (int threads : {1, 2}) {
-                const tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
-                const auto file = prism::encode_exr(image);
-                REQUIRE(file.has_value());
-                files.push_back(*file);
-            }
+            const auto files =
+                encoded_at_1_and_2_threads(image, [](const prism::Image& i) { return prism::encode_exr(i); });
             CHECK(files[0] == files[1]);
             const std::size_t raw_bytes = image.pixels.size() * 12;
             // Random bits are stored as they are, behind the header and the offsets; noise_image
@@ -277,10 +283,7 @@ TEST_CASE("encode_exr: tinyexr reads back every float's bits, from the same byte
             else if (raw_bytes > 8192) CHECK(files[0].size() < raw_bytes);
             const fs::path path = folder.path / "blocks.exr";
             prism::write_image(path, image);
-            std::ifstream stream(path, std::ios::binary);
-            const std::vector<std::uint8_t> written((std::istreambuf_iterator<char>(stream)),
-                                                   std::istreambuf_iterator<char>());
-            CHECK(written == files[0]);
+            CHECK(file_bytes(path) == files[0]);
             CHECK(bit_mismatches(prism::read_image(path), image) == 0);
         }
     }

@@ -155,7 +155,7 @@ Image tone_map(const Image& hdr, const scene::Tonemap& settings) {
     const Real saturation = Real(settings.saturation), gamma = Real(settings.gamma);
     // x^1 is x exactly: where the saturation is 1 (every course file that gives one), half
     // of the pixels' powers are spared.
-    const bool saturated = saturation == 1;
+    const bool unit_saturation = saturation == 1;
     for_each_run(Y.size(), tone_map_grain, [&](std::size_t first, std::size_t end) {
         for (std::size_t i = first; i < end; ++i) {
             if (Y[i] <= 0) {  // black stays black
@@ -172,7 +172,7 @@ Image tone_map(const Image& hdr, const scene::Tonemap& settings) {
             for (int c = 0; c < 3; ++c) {
                 // A negative channel (a colour outside the gamut) has no real power: it shows as 0.
                 const Real ratio = std::max(color[c], Real(0)) / Y[i];
-                const Real saturated_ratio = saturated ? ratio : std::pow(ratio, saturation);
+                const Real saturated_ratio = unit_saturation ? ratio : std::pow(ratio, saturation);
                 ldr.pixels[i][c] = float(display_level(saturated_ratio * displayed, gamma));
             }
         }
