@@ -43,6 +43,8 @@ list(APPEND PRISM_BAD_INPUTS
   "vertex_data_binary_truncated.xml|vertex_data_binary_truncated.xml|VertexData"
   "vertex_data_binary_device.xml|/dev/zero: vertex data: not a regular file|VertexData"
   "ply_device.xml|/dev/zero: not a regular file|Faces"
+  "scene_device.xml|scene_device.xml: not a regular file|not a regular file"
+  "scene_device.json|scene_device.json: not a regular file|not a regular file"
   "sphere_negative_radius.xml|sphere_negative_radius.xml|Radius"
   "sphere_unknown_center.xml|sphere_unknown_center.xml|Center"
   "plane_zero_normal.xml|plane_zero_normal.xml|Normal"

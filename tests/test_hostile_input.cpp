@@ -10,10 +10,13 @@
 #include <prism/io/load_error.hpp>
 #include <prism/io/output_path.hpp>
 #include <prism/io/ply.hpp>
+#include <prism/io/read_file.hpp>
 #include <prism/io/scene_loader.hpp>
 #include <prism/io/xml_reader.hpp>
 
 #include <doctest/doctest.h>
+
+#include <sys/stat.h>
 
 #include <cstdint>
 #include <filesystem>
@@ -254,6 +257,66 @@ TEST_CASE("decode_image: a file's content must be the format its name says; JPEG
 
 // Every input a fuzzer found, replayed through the reader it broke: each must now load or be refused
 // with a LoadError (a crash or a sanitizer report fails the test run).
+// Every reader (scenes, PLYs, binary data, images) takes its file through io::read_regular_file.
+// A named pipe is refused before it is opened (opening it waits for a writer: `prism pipe.xml`
+// hung), and a device before it is read (a scene that was a link to /dev/zero grew until the
+// memory ran out).
+TEST_CASE("read_regular_file: a regular file's bytes; no pipe, device or folder is opened") {
+    const prism_test::TemporaryFolder folder;
+    const auto refused = [](const std::filesystem::path& path, std::string_view kind, const std::string& why) {
+        try {
+            (void)prism::io::read_regular_file(path, "<Image id=\"1\">", kind);
+        } catch (const LoadError& error) {
+            CHECK(std::string(error.what()) == path.string() + ": <Image id=\"1\">: " + why);
+            return;
+        }
+        FAIL("read " << path.string());
+    };
+    SUBCASE("every byte of a regular file, and an empty one") {
+        std::string bytes(70000, '\0');
+        for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = char(i * 131 % 251);
+        CHECK(prism::io::read_regular_file(folder.write("bytes.bin", bytes)) == bytes);
+        CHECK(prism::io::read_regular_file(folder.write("empty.bin", "")).empty());
+        // A link to a regular file is that file.
+        std::filesystem::create_symlink(folder.path() / "bytes.bin", folder.path() / "link.bin");
+        CHECK(prism::io::read_regular_file(folder.path() / "link.bin") == bytes);
+    }
+    SUBCASE("absent, a folder") {
+        refused(folder.path() / "absent.png", "image file", "no such image file");
+        refused(folder.path(), "image file", "is a directory, not a file");
+    }
+    SUBCASE("a named pipe, by each reader") {
+        const std::filesystem::path pipe = folder.path() / "pipe";
+        REQUIRE(mkfifo(pipe.c_str(), 0600) == 0);
+        refused(pipe, "scene file", "not a regular file");
+        for (const char* name : {"pipe.xml", "pipe.json", "pipe.ply", "pipe.png"}) {
+            std::filesystem::create_symlink(pipe, folder.path() / name);
+            const std::filesystem::path path = folder.path() / name;
+            const std::string expected = path.string() + ": not a regular file";
+            const auto check = [&](const auto& read) {
+                try {
+                    read(path);
+                } catch (const LoadError& error) {
+                    CHECK(std::string(error.what()) == expected);
+                    return;
+                }
+                FAIL("read " << path.string());
+            };
+            const std::string extension = std::filesystem::path(name).extension().string();
+            if (extension == ".xml") check([](const std::filesystem::path& p) { (void)prism::io::read_xml(p); });
+            if (extension == ".json") check([](const std::filesystem::path& p) { (void)prism::io::read_json(p); });
+            if (extension == ".ply") check([](const std::filesystem::path& p) { (void)prism::io::read_ply(p); });
+            if (extension == ".png") check([](const std::filesystem::path& p) { (void)prism::read_texels(p); });
+        }
+    }
+    SUBCASE("a device, and a link to one") {
+        if (!std::filesystem::exists("/dev/zero")) return;
+        refused("/dev/zero", "binary data file", "not a regular file");
+        std::filesystem::create_symlink("/dev/zero", folder.path() / "zero.xml");
+        refused(folder.path() / "zero.xml", "scene file", "not a regular file");
+    }
+}
+
 TEST_CASE("the fuzzers' findings stay fixed") {
     const std::filesystem::path root = std::filesystem::path(PRISM_SOURCE_DIR) / "tests/data/fuzz";
     REQUIRE(std::filesystem::is_directory(root));

@@ -497,7 +497,7 @@ TEST_CASE("read_ply: the triangle the malformed cases start from is read") {
 }
 
 TEST_CASE("read_ply rejects: missing file, not a PLY, broken header") {
-    check_rejects(temporary_directory() / "does_not_exist.ply", "", "does not exist");
+    check_rejects(temporary_directory() / "does_not_exist.ply", "", "no such file");
     check_rejects(write_file("empty_file.ply", ""), "header line 1", "not a PLY file");
     check_rejects(write_file("obj_file.ply", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), "header line 1", "not a PLY file");
     check_rejects(write_file("plywood.ply", "plywood\nformat ascii 1.0\nend_header\n"), "header line 1", "not a PLY file");

@@ -11,6 +11,7 @@
 #include <prism/image/texels.hpp>
 #include <prism/io/limits.hpp>
 #include <prism/io/load_error.hpp>
+#include <prism/io/read_file.hpp>
 #include <prism/parallel/for_each_run.hpp>
 
 #include <stb_image.h>
@@ -353,26 +354,12 @@ inline Texels decode_texels(std::string_view bytes, const std::filesystem::path&
     return Texels(Texels::Bytes{decoded.width, decoded.height, std::shared_ptr<const std::uint8_t>(storage, storage->data())});
 }
 
-namespace detail {
-// An image file's bytes; only regular files are read, so a scene cannot name a device or a pipe
-// and block or exhaust the reader.
-inline std::string read_regular_file(const std::filesystem::path& path) {
-    std::error_code error;
-    if (!std::filesystem::is_regular_file(path, error)) throw io::LoadError(path, "", "no such image file");
-    std::ifstream stream(path, std::ios::binary);
-    if (!stream) throw io::LoadError(path, "", "cannot open the image file");
-    std::string bytes((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
-    if (stream.bad()) throw io::LoadError(path, "", "cannot read the image file");
-    return bytes;
-}
-}  // namespace detail
-
 // Reads an image file (see decode_image).
-inline Image read_image(const std::filesystem::path& path) { return decode_image(detail::read_regular_file(path), path); }
+inline Image read_image(const std::filesystem::path& path) { return decode_image(io::read_regular_file(path, "", "image file"), path); }
 
 // Reads a texture's image file (see decode_texels), as read_image reads one.
 inline Texels read_texels(const std::filesystem::path& path) {
-    return decode_texels(detail::read_regular_file(path), path);
+    return decode_texels(io::read_regular_file(path, "", "image file"), path);
 }
 
 }  // namespace prism

@@ -5,15 +5,13 @@
 #pragma once
 
 #include <prism/io/load_error.hpp>
+#include <prism/io/read_file.hpp>
 
 #include <bit>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
-#include <system_error>
 #include <vector>
 
 namespace prism::io {
@@ -23,12 +21,7 @@ namespace detail {
 template <class Value>
 std::vector<Value> read_binary_records(const std::filesystem::path& path, int width, const std::string& element) {
     static_assert(std::endian::native == std::endian::little, "binary data files are little-endian");
-    // Only a regular file: a scene naming /dev/zero or a pipe must not read without end.
-    std::error_code error;
-    if (!std::filesystem::is_regular_file(path, error)) throw LoadError(path, element, "not a regular file");
-    std::ifstream stream(path, std::ios::binary);
-    if (!stream) throw LoadError(path, element, "cannot open the binary data file");
-    const std::vector<char> bytes((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+    const std::string bytes = read_regular_file(path, element, "binary data file");
     std::int32_t count = 0;
     if (bytes.size() < sizeof count) throw LoadError(path, element, "too short for its record count");
     std::memcpy(&count, bytes.data(), sizeof count);

@@ -9,8 +9,6 @@
 #include <algorithm>
 #include <cstddef>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -80,17 +78,6 @@ inline void assign_paths(Element& root) {
     };
     root.path = element_label(root.name, root.attribute("id"));
     for (Element& c : root.children) assign(assign, c, "");
-}
-
-// Both readers parse the whole file from memory: pugixml needs the buffer to map its offsets to
-// lines, nlohmann's SAX parser reads it in one pass.
-inline std::string read_text_file(const std::filesystem::path& path) {
-    std::ifstream stream(path, std::ios::binary);
-    if (!stream) throw LoadError(path, "", "cannot open the file");
-    std::ostringstream contents;
-    contents << stream.rdbuf();
-    if (stream.bad()) throw LoadError(path, "", "cannot read the file");
-    return std::move(contents).str();
 }
 
 }  // namespace prism::io

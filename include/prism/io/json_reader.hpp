@@ -8,6 +8,7 @@
 #include <prism/io/element.hpp>
 #include <prism/io/limits.hpp>
 #include <prism/io/load_error.hpp>
+#include <prism/io/read_file.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -190,6 +191,6 @@ inline Element parse_json(std::string_view contents, const std::filesystem::path
     return builder.take_root(path);
 }
 
-inline Element read_json(const std::filesystem::path& path) { return parse_json(read_text_file(path), path); }
+inline Element read_json(const std::filesystem::path& path) { return parse_json(read_regular_file(path, "", "scene file"), path); }
 
 }  // namespace prism::io

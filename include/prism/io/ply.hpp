@@ -3,6 +3,7 @@
 #pragma once
 
 #include <prism/io/load_error.hpp>
+#include <prism/io/read_file.hpp>
 
 #include <glm/glm.hpp>
 
@@ -14,12 +15,10 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
-#include <system_error>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -545,23 +544,6 @@ void read_elements(const std::filesystem::path& path, const Header& header, Curs
     }
 }
 
-inline std::string read_file(const std::filesystem::path& path) {
-    std::error_code error;
-    if (!std::filesystem::exists(path, error)) throw LoadError(path, "", "file does not exist");
-    if (std::filesystem::is_directory(path, error)) throw LoadError(path, "", "is a directory, not a file");
-    // A device or a pipe (/dev/zero, /dev/stdin) could be read without end.
-    if (!std::filesystem::is_regular_file(path, error)) throw LoadError(path, "", "not a regular file");
-    std::ifstream stream(path, std::ios::binary);
-    if (!stream) throw LoadError(path, "", "cannot open the file for reading");
-    stream.seekg(0, std::ios::end);
-    const std::streamoff size = stream.tellg();
-    if (size < 0) throw LoadError(path, "", "cannot determine the file size");
-    stream.seekg(0, std::ios::beg);
-    std::string bytes(static_cast<std::size_t>(size), '\0');
-    if (!stream.read(bytes.data(), size)) throw LoadError(path, "", "read error");
-    return bytes;
-}
-
 }  // namespace detail::ply
 
 // Parses a PLY file's bytes already in memory; `path` names the file in messages.
@@ -584,6 +566,6 @@ inline PlyMesh parse_ply(std::string_view bytes, const std::filesystem::path& pa
     return mesh;
 }
 
-inline PlyMesh read_ply(const std::filesystem::path& path) { return parse_ply(detail::ply::read_file(path), path); }
+inline PlyMesh read_ply(const std::filesystem::path& path) { return parse_ply(read_regular_file(path), path); }
 
 }  // namespace prism::io

@@ -6,6 +6,7 @@
 #include <prism/io/element.hpp>
 #include <prism/io/limits.hpp>
 #include <prism/io/load_error.hpp>
+#include <prism/io/read_file.hpp>
 
 #include <pugixml.hpp>
 
@@ -152,6 +153,6 @@ inline Element parse_xml(std::string_view contents, const std::filesystem::path&
     return tree;
 }
 
-inline Element read_xml(const std::filesystem::path& path) { return parse_xml(read_text_file(path), path); }
+inline Element read_xml(const std::filesystem::path& path) { return parse_xml(read_regular_file(path, "", "scene file"), path); }
 
 }  // namespace prism::io
