@@ -7,6 +7,7 @@
 #include <prism/image/image_io.hpp>
 #include <prism/io/json_reader.hpp>
 #include <prism/io/limits.hpp>
+#include <prism/io/load.hpp>
 #include <prism/io/load_error.hpp>
 #include <prism/io/output_path.hpp>
 #include <prism/io/ply.hpp>
@@ -115,6 +116,39 @@ TEST_CASE("meshes that would need more memory to render than the limit are refus
     CHECK(contains(message, "<Mesh id=\"2\">"));
     CHECK(contains(message, "2 triangles"));
     CHECK(prism::io::physical_memory_bytes() > 0);
+}
+
+// Texture images count with the meshes against the same limit, weighed from their headers before
+// they are decoded: each image may be within the image limits and still, with enough of them,
+// pass the machine's memory (a few hundred kB of PNG holds 2^26 texels of one colour).
+TEST_CASE("texture images that would need more memory than the limit are refused at the image, undecoded") {
+    const prism_test::TemporaryFolder folder;
+    prism::write_image(folder.path() / "a.png", prism::Image(512, 512));
+    prism::write_image(folder.path() / "b.png", prism::Image(512, 512));
+    const std::uint64_t image = prism::io::texture_bytes(512 * 512, 3);
+    REQUIRE(image == std::uint64_t(1) << 20);
+    const auto load = [&](const std::string& images, std::uint64_t limit) {
+        prism::io::LoadOptions options;
+        options.limits.memory_bytes = limit;
+        const std::filesystem::path scene =
+            folder.write("scene.xml", scene_text("<Textures><Images>" + images + "</Images></Textures>"));
+        return refusal([&] { (void)prism::io::load_scene(scene, options); });
+    };
+    const std::string one = "<Image id=\"1\">a.png</Image>", two = one + "<Image id=\"2\">b.png</Image>";
+    // Within the limit: two images (decoded side by side) and the mesh's triangle.
+    CHECK(load(two, 2 * image + prism::io::render_bytes_per_triangle) == "");
+    // The second image passes it: refused there, naming its file.
+    std::string message = load(two, image + prism::io::render_bytes_per_triangle);
+    CHECK(contains(message, "<Image id=\"2\">"));
+    CHECK(contains(message, "b.png: the scene's images reach 2 MiB here (this one 512 x 512)"));
+    // The only image (decoded alone), one byte over.
+    message = load(one, image - 1);
+    CHECK(contains(message, "<Image id=\"1\">"));
+    CHECK(contains(message, "a.png: the scene's images reach 1 MiB here"));
+    // The image fits, the mesh after it does not: the mesh is refused, with the images counted.
+    message = load(one, image + prism::io::render_bytes_per_triangle - 1);
+    CHECK(contains(message, "<Mesh id=\"1\">"));
+    CHECK(contains(message, "1 triangles here, about 1 MiB to render with its images' 1 MiB"));
 }
 
 TEST_CASE("200,000 nested elements are refused in XML and JSON, without recursion that deep") {

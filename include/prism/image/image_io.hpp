@@ -159,6 +159,31 @@ inline void check_image_size(const std::filesystem::path& path, std::int64_t wid
                                           " per side and " + std::to_string(max_pixels) + " in all");
 }
 
+// An OpenEXR file's header, parsed into `header` (initialised by the caller, freed by it on
+// success and here on failure) with its data window checked against the limits: what decode_exr
+// and image_extent read first.
+inline void read_exr_header(std::string_view bytes, const std::filesystem::path& path, std::int64_t max_pixels,
+                            EXRVersion& version, EXRHeader& header) {
+    const auto* memory = reinterpret_cast<const unsigned char*>(bytes.data());
+    if (ParseEXRVersionFromMemory(&version, memory, bytes.size()) != TINYEXR_SUCCESS)
+        throw io::LoadError(path, "", "not an OpenEXR file");
+    if (version.multipart || version.non_image) throw io::LoadError(path, "", "multi-part and deep EXR files are not supported");
+    const char* message = nullptr;
+    if (ParseEXRHeaderFromMemory(&header, &version, memory, bytes.size(), &message) != TINYEXR_SUCCESS) {
+        FreeEXRHeader(&header);
+        const std::string what = message ? message : "cannot read the EXR header";
+        if (message) FreeEXRErrorMessage(message);
+        throw io::LoadError(path, "", what);
+    }
+    try {
+        check_image_size(path, std::int64_t(header.data_window.max_x) - header.data_window.min_x + 1,
+                         std::int64_t(header.data_window.max_y) - header.data_window.min_y + 1, max_pixels);
+    } catch (...) {
+        FreeEXRHeader(&header);
+        throw;
+    }
+}
+
 // OpenEXR through tinyexr's header-then-image calls (not LoadEXRFromMemory), so that the data
 // window is checked before the pixels are allocated and every path frees what tinyexr allocated.
 inline Image decode_exr(std::string_view bytes, const std::filesystem::path& path, std::int64_t max_pixels) {
@@ -170,21 +195,13 @@ inline Image decode_exr(std::string_view bytes, const std::filesystem::path& pat
         return io::LoadError(path, "", what);
     };
     EXRVersion version;
-    if (ParseEXRVersionFromMemory(&version, memory, bytes.size()) != TINYEXR_SUCCESS)
-        throw io::LoadError(path, "", "not an OpenEXR file");
-    if (version.multipart || version.non_image) throw io::LoadError(path, "", "multi-part and deep EXR files are not supported");
     EXRHeader header;
     InitEXRHeader(&header);
-    if (ParseEXRHeaderFromMemory(&header, &version, memory, bytes.size(), &message) != TINYEXR_SUCCESS) {
-        FreeEXRHeader(&header);
-        throw fail("cannot read the EXR header");
-    }
+    read_exr_header(bytes, path, max_pixels, version, header);
     struct HeaderGuard {
         EXRHeader& header;
         ~HeaderGuard() { FreeEXRHeader(&header); }
     } header_guard{header};
-    check_image_size(path, std::int64_t(header.data_window.max_x) - header.data_window.min_x + 1,
-                     std::int64_t(header.data_window.max_y) - header.data_window.min_y + 1, max_pixels);
     int channel_of[3] = {-1, -1, -1};  // R, G, B; a single channel (Y or anything) is grey
     for (int c = 0; c < header.num_channels; ++c) {
         if (header.pixel_types[c] == TINYEXR_PIXELTYPE_HALF) header.requested_pixel_types[c] = TINYEXR_PIXELTYPE_FLOAT;
@@ -254,6 +271,7 @@ inline bool is_ldr_extension(const std::string& extension) {
 struct StbInput {
     const stbi_uc* memory = nullptr;
     int length = 0;
+    int width = 0, height = 0;  // from the header
 };
 inline StbInput checked_stb_input(std::string_view bytes, const std::filesystem::path& path,
                                   const std::string& extension, std::int64_t max_pixels) {
@@ -269,10 +287,10 @@ inline StbInput checked_stb_input(std::string_view bytes, const std::filesystem:
     if (bytes.size() > std::size_t(std::numeric_limits<int>::max()))
         throw io::LoadError(path, "", "the file is larger than 2 GiB");
     StbInput input{reinterpret_cast<const stbi_uc*>(bytes.data()), int(bytes.size())};
-    int width = 0, height = 0, channels = 0;
-    if (!stbi_info_from_memory(input.memory, input.length, &width, &height, &channels))
+    int channels = 0;
+    if (!stbi_info_from_memory(input.memory, input.length, &input.width, &input.height, &channels))
         throw io::LoadError(path, "", "cannot read the image: " + stb_failure());
-    check_image_size(path, width, height, max_pixels);
+    check_image_size(path, input.width, input.height, max_pixels);
     return input;
 }
 
@@ -352,6 +370,30 @@ inline Texels decode_texels(std::string_view bytes, const std::filesystem::path&
         std::copy(data + first, data + end, storage->data() + first);
     });
     return Texels(Texels::Bytes{decoded.width, decoded.height, std::shared_ptr<const std::uint8_t>(storage, storage->data())});
+}
+
+// An image file's size from its header, after the checks decode_image and decode_texels make
+// first (the format its name says, the size limits); nothing is decoded. `texel_bytes`: what a
+// texel of it takes as decode_texels stores it (8-bit files their 3 bytes, .hdr and .exr 3 floats).
+struct ImageExtent {
+    std::int64_t width = 0, height = 0;
+    std::uint64_t texel_bytes = 0;
+};
+inline ImageExtent image_extent(std::string_view bytes, const std::filesystem::path& path,
+                                std::int64_t max_pixels = io::max_image_pixels) {
+    const std::string extension = detail::lowercase_extension(path);
+    if (extension == ".exr") {
+        EXRVersion version;
+        EXRHeader header;
+        InitEXRHeader(&header);
+        detail::read_exr_header(bytes, path, max_pixels, version, header);
+        const ImageExtent extent{std::int64_t(header.data_window.max_x) - header.data_window.min_x + 1,
+                                 std::int64_t(header.data_window.max_y) - header.data_window.min_y + 1, 3 * sizeof(float)};
+        FreeEXRHeader(&header);
+        return extent;
+    }
+    const detail::StbInput input = detail::checked_stb_input(bytes, path, extension, max_pixels);
+    return {input.width, input.height, detail::is_ldr_extension(extension) ? 3u : 3 * sizeof(float)};
 }
 
 // Reads an image file (see decode_image).

@@ -29,11 +29,11 @@ namespace prism::io::detail::scene_loader {
 
 class ObjectLoader {
 public:
-    ObjectLoader(ElementReader& reader, scene::Scene& scene, const ResourceLimits& limits,
+    ObjectLoader(ElementReader& reader, scene::Scene& scene, const ResourceLimits& limits, MemoryUse& memory,
                  const TransformationLoader& transformations, const MaterialLoader& materials, const TextureLoader& textures,
                  VertexDataLoader& vertex_data)
-        : reader_(reader), scene_(scene), limits_(limits), transformations_(transformations), materials_(materials),
-          textures_(textures), vertex_data_(vertex_data) {}
+        : reader_(reader), scene_(scene), limits_(limits), memory_(memory), transformations_(transformations),
+          materials_(materials), textures_(textures), vertex_data_(vertex_data) {}
 
     void read(const Element& section) {
         std::vector<const Element*> instances;
@@ -129,15 +129,17 @@ private:
         scene_.meshes.push_back(std::move(mesh));
     }
 
-    // The scene's triangles so far against the memory rendering them will take (limits.hpp).
+    // The scene's triangles so far, with its images, against the memory rendering them will take
+    // (limits.hpp).
     void count_triangles(const Element& element, std::size_t added) {
-        triangles_ += added;
-        const std::uint64_t needed = triangles_ * render_bytes_per_triangle;
+        memory_.triangles += added;
+        const std::uint64_t needed = memory_.bytes();
         if (limits_.memory_bytes != 0 && needed > limits_.memory_bytes) {
-            const auto mib = [](std::uint64_t bytes) { return std::to_string(bytes >> 20) + " MiB"; };
-            reader_.fail(element, "the scene's meshes reach " + std::to_string(triangles_) + " triangles here, about " +
-                                      mib(needed) + " to render, more than the " + mib(limits_.memory_bytes) +
-                                      " of memory prism may use");
+            const std::string images =
+                memory_.image_bytes > 0 ? " with its images' " + MemoryUse::mib(memory_.image_bytes) : "";
+            reader_.fail(element, "the scene's meshes reach " + std::to_string(memory_.triangles) + " triangles here, about " +
+                                      MemoryUse::mib(needed) + " to render" + images + ", more than the " +
+                                      MemoryUse::mib(limits_.memory_bytes) + " of memory prism may use");
         }
     }
 
@@ -255,13 +257,13 @@ private:
     ElementReader& reader_;
     scene::Scene& scene_;
     const ResourceLimits& limits_;
+    MemoryUse& memory_;  // shared with the texture loader
     const TransformationLoader& transformations_;
     const MaterialLoader& materials_;
     const TextureLoader& textures_;
     VertexDataLoader& vertex_data_;
     std::map<std::string, std::size_t> mesh_indices_;     // ids of Mesh elements only
     std::set<std::string> ambiguous_mesh_ids_;
-    std::uint64_t triangles_ = 0;
 };
 
 }  // namespace prism::io::detail::scene_loader

@@ -100,14 +100,15 @@ public:
 private:
     LoadOptions options_;
     scene::Scene scene_;
-    TextureLoader textures_{*this, scene_};
+    MemoryUse memory_;  // what the meshes and images read so far will take (limits.hpp)
+    TextureLoader textures_{*this, scene_, options_.limits, memory_};
     BrdfLoader brdfs_{*this};
     TransformationLoader transformations_{*this};
     MaterialLoader materials_{*this, scene_, brdfs_, options_.untyped_mirrors_reflect};
     CameraLoader cameras_{*this, scene_, transformations_};
     LightLoader lights_{*this, scene_, transformations_, textures_};
     VertexDataLoader vertex_data_{*this};
-    ObjectLoader objects_{*this, scene_, options_.limits, transformations_, materials_, textures_, vertex_data_};
+    ObjectLoader objects_{*this, scene_, options_.limits, memory_, transformations_, materials_, textures_, vertex_data_};
 };
 
 }  // namespace detail::scene_loader

@@ -14,15 +14,18 @@
 // bump_normal). So such a texture becomes two scene textures, the DecalMode one and a bump_normal
 // one with BumpFactor = bumpmapMultiplier (default 1), and an object naming it gets both, in that
 // order. With DecalMode bump_normal or no DecalMode, bumpmap="true" gives the bump texture alone.
-// Images are decoded once per file (read_texels: 8-bit files keep their bytes 0..255), relative to the scene's
-// folder. The replace_background texture, named by no object in the course's files
+// Images are decoded once per file (decode_texels: 8-bit files keep their bytes 0..255), relative to the scene's
+// folder, each weighed from its header first against the memory the scene may take with its meshes
+// (MemoryUse, limits.hpp). The replace_background texture, named by no object in the course's files
 // (galactica_static.xml), is the scene's background; a scene may have one.
 #pragma once
 
 #include <prism/image/image_io.hpp>
 #include <prism/io/element.hpp>
 #include <prism/io/element_reader.hpp>
+#include <prism/io/limits.hpp>
 #include <prism/io/load_error.hpp>
+#include <prism/io/read_file.hpp>
 #include <prism/scene/scene.hpp>
 
 #include <algorithm>
@@ -43,7 +46,8 @@ namespace prism::io::detail::scene_loader {
 
 class TextureLoader {
 public:
-    TextureLoader(ElementReader& reader, scene::Scene& scene) : reader_(reader), scene_(scene) {}
+    TextureLoader(ElementReader& reader, scene::Scene& scene, const ResourceLimits& limits, MemoryUse& memory)
+        : reader_(reader), scene_(scene), limits_(limits), memory_(memory) {}
 
     // One <Textures> section.
     void read(const Element& section) {
@@ -224,24 +228,76 @@ private:
     // error, in the block's order, so a scene with several faults reports the same first one.
     void decode_side_by_side(const Element& images) {
         std::vector<std::filesystem::path> paths;
+        std::vector<const Element*> naming;  // the first <Image> naming each path
         for (const Element& image : images.children) {
             if (image.name != "Image") continue;
             const std::string written = reader_.text_of(image);
             if (written.empty()) continue;  // decode() reports it in turn
             const std::filesystem::path path = image_path(written);
-            if (!decoded_.contains(path) && std::find(paths.begin(), paths.end(), path) == paths.end())
+            if (!decoded_.contains(path) && std::find(paths.begin(), paths.end(), path) == paths.end()) {
                 paths.push_back(path);
+                naming.push_back(&image);
+            }
         }
         if (paths.size() < 2) return;  // one file: decode() reads it in turn
+        // Read and weighed one after another, in the block's order, then decoded side by side. A
+        // file that cannot be read or whose header is bad ends the reading: decode() meets its
+        // fault before any file after it. A file past the memory limit ends the load there,
+        // before anything is decoded.
         std::vector<Predecoded> results(paths.size());
-        tbb::parallel_for(std::size_t(0), paths.size(), [&](std::size_t i) {
+        std::vector<std::string> bytes(paths.size());
+        std::size_t read = 0;
+        while (read < paths.size()) {
+            const std::size_t i = read++;
+            Measured measured;
             try {
-                results[i].texels = std::make_shared<const Texels>(read_texels(paths[i]));
+                measured = measure(paths[i]);
+            } catch (...) {
+                results[i].error = std::current_exception();
+                break;
+            }
+            try {
+                charge(paths[i], measured);
+            } catch (const LoadError& error) {
+                throw LoadError(reader_.file(), naming[i]->where(), error.what());
+            }
+            bytes[i] = std::move(measured.bytes);
+        }
+        tbb::parallel_for(std::size_t(0), read, [&](std::size_t i) {
+            if (results[i].error) return;
+            try {
+                results[i].texels = std::make_shared<const Texels>(decode_texels(bytes[i], paths[i]));
             } catch (...) {
                 results[i].error = std::current_exception();
             }
+            bytes[i] = std::string();
         });
-        for (std::size_t i = 0; i < paths.size(); ++i) predecoded_.insert_or_assign(paths[i], std::move(results[i]));
+        for (std::size_t i = 0; i < read; ++i) predecoded_.insert_or_assign(paths[i], std::move(results[i]));
+    }
+
+    // An image file's bytes and its size from its header (image_extent): what it will take is
+    // known before it is decoded.
+    struct Measured {
+        std::string bytes;
+        ImageExtent extent;
+    };
+    static Measured measure(const std::filesystem::path& path) {
+        Measured measured{read_regular_file(path, "", "image file"), {}};
+        measured.extent = image_extent(measured.bytes, path);
+        return measured;
+    }
+
+    // Adds a measured image to what the scene will take (MemoryUse, limits.hpp); past the memory
+    // limit, refused, naming the file.
+    void charge(const std::filesystem::path& path, const Measured& image) {
+        const ImageExtent& extent = image.extent;
+        memory_.image_bytes += texture_bytes(std::uint64_t(extent.width) * std::uint64_t(extent.height), extent.texel_bytes);
+        if (limits_.memory_bytes != 0 && memory_.bytes() > limits_.memory_bytes)
+            throw LoadError(path, "",
+                            "the scene's images reach " + MemoryUse::mib(memory_.image_bytes) + " here (this one " +
+                                std::to_string(extent.width) + " x " + std::to_string(extent.height) + "), about " +
+                                MemoryUse::mib(memory_.bytes()) + " to render with its meshes, more than the " +
+                                MemoryUse::mib(limits_.memory_bytes) + " of memory prism may use");
     }
 
     // Decodes `written` (relative to the scene's folder) once; later textures naming the same file
@@ -259,7 +315,9 @@ private:
                 if (predecoded.error) std::rethrow_exception(predecoded.error);
                 image.texels = std::move(predecoded.texels);
             } else {
-                image.texels = std::make_shared<const Texels>(read_texels(path));
+                const Measured measured = measure(path);
+                charge(path, measured);
+                image.texels = std::make_shared<const Texels>(decode_texels(measured.bytes, path));
             }
         } catch (const LoadError& error) {
             throw LoadError(reader_.file(), element.where(), error.what());
@@ -273,6 +331,8 @@ private:
 
     ElementReader& reader_;
     scene::Scene& scene_;
+    const ResourceLimits& limits_;
+    MemoryUse& memory_;  // shared with the object loader
     std::map<std::string, std::size_t> image_ids_;
     std::map<std::string, std::vector<std::size_t>> texture_ids_;  // an older-schema bump map makes two
     std::map<std::filesystem::path, std::size_t> decoded_;
