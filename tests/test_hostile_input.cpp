@@ -107,7 +107,8 @@ TEST_CASE("ImageResolution and NumSamples past prism's limits are refused, namin
 
 TEST_CASE("meshes that would need more memory to render than the limit are refused at the mesh") {
     prism::io::LoadOptions options;
-    options.limits.memory_bytes = prism::io::render_bytes_per_triangle;  // one triangle's worth
+    // The camera's 16 x 16 film and one triangle's worth.
+    options.limits.memory_bytes = 16 * 16 * prism::io::film_bytes_per_pixel + prism::io::render_bytes_per_triangle;
     CHECK(load_text(scene_text(""), options).meshes.size() == 1);
     std::string two = scene_text("");
     const std::string mesh = "<Mesh id=\"1\"><Material>1</Material><Faces>1 2 3</Faces></Mesh>";
@@ -127,6 +128,7 @@ TEST_CASE("texture images that would need more memory than the limit are refused
     prism::write_image(folder.path() / "b.png", prism::Image(512, 512));
     const std::uint64_t image = prism::io::texture_bytes(512 * 512, 3);
     REQUIRE(image == std::uint64_t(1) << 20);
+    const std::uint64_t film = 16 * 16 * prism::io::film_bytes_per_pixel, triangle = prism::io::render_bytes_per_triangle;
     const auto load = [&](const std::string& images, std::uint64_t limit) {
         prism::io::LoadOptions options;
         options.limits.memory_bytes = limit;
@@ -136,19 +138,38 @@ TEST_CASE("texture images that would need more memory than the limit are refused
     };
     const std::string one = "<Image id=\"1\">a.png</Image>", two = one + "<Image id=\"2\">b.png</Image>";
     // Within the limit: two images (decoded side by side) and the mesh's triangle.
-    CHECK(load(two, 2 * image + prism::io::render_bytes_per_triangle) == "");
+    CHECK(load(two, 2 * image + film + triangle) == "");
     // The second image passes it: refused there, naming its file.
-    std::string message = load(two, image + prism::io::render_bytes_per_triangle);
+    std::string message = load(two, image + film + triangle);
     CHECK(contains(message, "<Image id=\"2\">"));
-    CHECK(contains(message, "b.png: the scene's images reach 2 MiB here (this one 512 x 512)"));
+    CHECK(contains(message, "b.png: the scene's textures reach 2 MiB here (this one 512 x 512): about 2 MiB to render "
+                            "(meshes 0 MiB, textures 2 MiB, films 0 MiB)"));
     // The only image (decoded alone), one byte over.
     message = load(one, image - 1);
     CHECK(contains(message, "<Image id=\"1\">"));
-    CHECK(contains(message, "a.png: the scene's images reach 1 MiB here"));
+    CHECK(contains(message, "a.png: the scene's textures reach 1 MiB here"));
     // The image fits, the mesh after it does not: the mesh is refused, with the images counted.
-    message = load(one, image + prism::io::render_bytes_per_triangle - 1);
+    message = load(one, image + film + triangle - 1);
     CHECK(contains(message, "<Mesh id=\"1\">"));
-    CHECK(contains(message, "1 triangles here, about 1 MiB to render with its images' 1 MiB"));
+    CHECK(contains(message, "1 triangles here: about 1 MiB to render (meshes 0 MiB, textures 1 MiB"));
+}
+
+// Every camera's film is kept until all are rendered: many cameras of the largest resolution
+// allowed could pass the machine's memory.
+TEST_CASE("cameras whose films would need more memory than the limit are refused at the resolution") {
+    std::string two = scene_text("");
+    const std::string second = "<Camera id=\"2\"><Position>0 0 0</Position><Gaze>0 0 -1</Gaze><Up>0 1 0</Up>"
+                               "<NearPlane>-1 1 -1 1</NearPlane><NearDistance>1</NearDistance>"
+                               "<ImageResolution>512 512</ImageResolution><ImageName>two.png</ImageName></Camera>";
+    two.insert(two.find("</Cameras>"), second);
+    const std::uint64_t films = (16 * 16 + 512 * 512) * prism::io::film_bytes_per_pixel;
+    prism::io::LoadOptions options;
+    options.limits.memory_bytes = films + prism::io::render_bytes_per_triangle;
+    CHECK(load_text(two, options).cameras.size() == 2);
+    options.limits.memory_bytes = films - 1;
+    const std::string message = refusal([&] { load_text(two, options); });
+    CHECK(contains(message, "<Camera id=\"2\">/<ImageResolution>"));
+    CHECK(contains(message, "the scene's films reach 3 MiB here (this one 512 x 512): about 3 MiB to render"));
 }
 
 TEST_CASE("200,000 nested elements are refused in XML and JSON, without recursion that deep") {

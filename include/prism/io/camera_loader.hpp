@@ -31,8 +31,9 @@ namespace prism::io::detail::scene_loader {
 
 class CameraLoader {
 public:
-    CameraLoader(ElementReader& reader, scene::Scene& scene, const TransformationLoader& transformations)
-        : reader_(reader), scene_(scene), transformations_(transformations) {}
+    CameraLoader(ElementReader& reader, scene::Scene& scene, const TransformationLoader& transformations,
+                 const ResourceLimits& limits, MemoryUse& memory)
+        : reader_(reader), scene_(scene), transformations_(transformations), limits_(limits), memory_(memory) {}
 
     // A <Cameras> section.
     void read(const Element& section) {
@@ -69,6 +70,13 @@ public:
                                          " pixels a side and " + std::to_string(max_image_pixels) + " in all");
         camera.width = int(size[0]);
         camera.height = int(size[1]);
+        // Every camera's film is kept until all are rendered: together with the meshes and
+        // textures, within the memory limit (limits.hpp).
+        memory_.film_bytes += std::uint64_t(size[0]) * std::uint64_t(size[1]) * film_bytes_per_pixel;
+        if (memory_.over(limits_.memory_bytes))
+            reader_.fail(resolution, "the scene's films reach " + MemoryUse::mib(memory_.film_bytes) + " here (this one " +
+                                         std::to_string(size[0]) + " x " + std::to_string(size[1]) +
+                                         "): " + memory_.over_message(limits_.memory_bytes));
 
         // The gaze is a point to look at (lookAt) or a direction. Some lookAt cameras of 2019-2022
         // give a Gaze direction instead of a GazePoint, so each form falls back on the other.
@@ -250,6 +258,8 @@ private:
     ElementReader& reader_;
     scene::Scene& scene_;
     const TransformationLoader& transformations_;
+    const ResourceLimits& limits_;
+    MemoryUse& memory_;  // shared with the object and texture loaders
 };
 
 }  // namespace prism::io::detail::scene_loader

@@ -62,15 +62,27 @@ struct ResourceLimits {
     std::uint64_t memory_bytes = physical_memory_bytes();
 };
 
-// What the meshes and texture images a loader has read so far will take to render, which
-// together may not pass ResourceLimits::memory_bytes: a scene of many large images (each within
-// the image limits, a few hundred kB of PNG for 2^26 texels of one colour) was decoded until the
-// machine ran out of memory.
+// A camera's film: float RGB a pixel, every camera's kept until all are rendered (so that a
+// scene that fails writes no image).
+inline constexpr std::uint64_t film_bytes_per_pixel = 12;
+
+// What the meshes, texture images and films a loader has read so far will take to render, which
+// together may not pass ResourceLimits::memory_bytes. Each alone has its limit (the image and
+// resolution limits above), and many of them still passed the machine's memory: a scene of many
+// large images (a few hundred kB of PNG for 2^26 texels of one colour) was decoded until the
+// memory ran out, and one of many 2^27-pixel cameras rendered until it did.
 struct MemoryUse {
     std::uint64_t triangles = 0;
-    std::uint64_t image_bytes = 0;
-    std::uint64_t bytes() const { return triangles * render_bytes_per_triangle + image_bytes; }
-    // "about N MiB to render" and the limit, for the messages of a scene that passes it.
+    std::uint64_t texture_bytes = 0;
+    std::uint64_t film_bytes = 0;
+    std::uint64_t bytes() const { return triangles * render_bytes_per_triangle + texture_bytes + film_bytes; }
+    bool over(std::uint64_t limit) const { return limit != 0 && bytes() > limit; }
+    // What a scene that passes `limit` is told, after what its element added.
+    std::string over_message(std::uint64_t limit) const {
+        return "about " + mib(bytes()) + " to render (meshes " + mib(triangles * render_bytes_per_triangle) +
+               ", textures " + mib(texture_bytes) + ", films " + mib(film_bytes) + "), more than the " + mib(limit) +
+               " of memory prism may use";
+    }
     static std::string mib(std::uint64_t bytes) { return std::to_string(bytes >> 20) + " MiB"; }
 };
 

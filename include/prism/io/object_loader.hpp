@@ -129,18 +129,13 @@ private:
         scene_.meshes.push_back(std::move(mesh));
     }
 
-    // The scene's triangles so far, with its images, against the memory rendering them will take
-    // (limits.hpp).
+    // The scene's triangles so far, with its textures and films, against the memory rendering them
+    // will take (limits.hpp).
     void count_triangles(const Element& element, std::size_t added) {
         memory_.triangles += added;
-        const std::uint64_t needed = memory_.bytes();
-        if (limits_.memory_bytes != 0 && needed > limits_.memory_bytes) {
-            const std::string images =
-                memory_.image_bytes > 0 ? " with its images' " + MemoryUse::mib(memory_.image_bytes) : "";
-            reader_.fail(element, "the scene's meshes reach " + std::to_string(memory_.triangles) + " triangles here, about " +
-                                      MemoryUse::mib(needed) + " to render" + images + ", more than the " +
-                                      MemoryUse::mib(limits_.memory_bytes) + " of memory prism may use");
-        }
+        if (memory_.over(limits_.memory_bytes))
+            reader_.fail(element, "the scene's meshes reach " + std::to_string(memory_.triangles) + " triangles here: " +
+                                      memory_.over_message(limits_.memory_bytes));
     }
 
     // A <LightSphere> is a Sphere with a <Radiance> (emitting = true).
@@ -257,7 +252,7 @@ private:
     ElementReader& reader_;
     scene::Scene& scene_;
     const ResourceLimits& limits_;
-    MemoryUse& memory_;  // shared with the texture loader
+    MemoryUse& memory_;  // shared with the texture and camera loaders
     const TransformationLoader& transformations_;
     const MaterialLoader& materials_;
     const TextureLoader& textures_;

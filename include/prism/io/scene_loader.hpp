@@ -105,7 +105,7 @@ private:
     BrdfLoader brdfs_{*this};
     TransformationLoader transformations_{*this};
     MaterialLoader materials_{*this, scene_, brdfs_, options_.untyped_mirrors_reflect};
-    CameraLoader cameras_{*this, scene_, transformations_};
+    CameraLoader cameras_{*this, scene_, transformations_, options_.limits, memory_};
     LightLoader lights_{*this, scene_, transformations_, textures_};
     VertexDataLoader vertex_data_{*this};
     ObjectLoader objects_{*this, scene_, options_.limits, memory_, transformations_, materials_, textures_, vertex_data_};

@@ -291,13 +291,12 @@ private:
     // limit, refused, naming the file.
     void charge(const std::filesystem::path& path, const Measured& image) {
         const ImageExtent& extent = image.extent;
-        memory_.image_bytes += texture_bytes(std::uint64_t(extent.width) * std::uint64_t(extent.height), extent.texel_bytes);
-        if (limits_.memory_bytes != 0 && memory_.bytes() > limits_.memory_bytes)
+        memory_.texture_bytes += texture_bytes(std::uint64_t(extent.width) * std::uint64_t(extent.height), extent.texel_bytes);
+        if (memory_.over(limits_.memory_bytes))
             throw LoadError(path, "",
-                            "the scene's images reach " + MemoryUse::mib(memory_.image_bytes) + " here (this one " +
-                                std::to_string(extent.width) + " x " + std::to_string(extent.height) + "), about " +
-                                MemoryUse::mib(memory_.bytes()) + " to render with its meshes, more than the " +
-                                MemoryUse::mib(limits_.memory_bytes) + " of memory prism may use");
+                            "the scene's textures reach " + MemoryUse::mib(memory_.texture_bytes) + " here (this one " +
+                                std::to_string(extent.width) + " x " + std::to_string(extent.height) +
+                                "): " + memory_.over_message(limits_.memory_bytes));
     }
 
     // Decodes `written` (relative to the scene's folder) once; later textures naming the same file
@@ -332,7 +331,7 @@ private:
     ElementReader& reader_;
     scene::Scene& scene_;
     const ResourceLimits& limits_;
-    MemoryUse& memory_;  // shared with the object loader
+    MemoryUse& memory_;  // shared with the object and camera loaders
     std::map<std::string, std::size_t> image_ids_;
     std::map<std::string, std::vector<std::size_t>> texture_ids_;  // an older-schema bump map makes two
     std::map<std::filesystem::path, std::size_t> decoded_;
