@@ -340,6 +340,13 @@ TEST_CASE("read_regular_file: a regular file's bytes; no pipe, device or folder 
         refused(folder.path() / "absent.png", "image file", "no such image file");
         refused(folder.path(), "image file", "is a directory, not a file");
     }
+    SUBCASE("larger than prism reads, refused before it is read (a sparse file)") {
+        const std::filesystem::path huge = folder.write("huge.png", "");
+        std::filesystem::resize_file(huge, prism::io::max_file_bytes + 1);
+        refused(huge, "image file", "the image file is 2048 MiB; prism reads at most 2048 MiB");
+        std::filesystem::resize_file(huge, 3 * prism::io::max_file_bytes);
+        refused(huge, "image file", "the image file is 6144 MiB; prism reads at most 2048 MiB");
+    }
     SUBCASE("a named pipe, by each reader") {
         const std::filesystem::path pipe = folder.path() / "pipe";
         REQUIRE(mkfifo(pipe.c_str(), 0600) == 0);

@@ -30,6 +30,13 @@ inline constexpr int stack_safe_recursion_depth = 512;
 inline constexpr std::int64_t max_image_side = 32768;
 inline constexpr std::int64_t max_image_pixels = std::int64_t(1) << 27;
 
+// Files a scene names (and the scene file itself) are read whole, so their size is bounded before
+// they are read: a sparse file of any size costs nothing on disk, and one of 3 GB named as a
+// texture was read into 3 GB of memory before its content was refused. The course's largest
+// file is 3.9 MB (an EXR); stb_image reads at most 2 GiB; a binary PLY of 2 GiB holds some 60
+// million triangles, which take more than 17 GB to render.
+inline constexpr std::uint64_t max_file_bytes = std::uint64_t(1) << 31;
+
 // Samples per pixel: the course's most is 2500.
 inline constexpr std::int64_t max_samples_per_pixel = 65536;
 

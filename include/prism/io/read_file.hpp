@@ -6,8 +6,10 @@
 // are read in one call into one buffer of that size, not grown and copied as they come.
 #pragma once
 
+#include <prism/io/limits.hpp>
 #include <prism/io/load_error.hpp>
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -19,7 +21,8 @@ namespace prism::io {
 // The bytes of `path`; `element` is the scene element that named it (empty for a file named on
 // its own), `kind` what the messages call it ("image file": "no such image file"). Throws
 // LoadError naming the file, the element and what is wrong: absent, a folder, not a regular
-// file (a device, a pipe, a socket), unreadable, or shorter than its size when read.
+// file (a device, a pipe, a socket), larger than max_file_bytes (limits.hpp), unreadable, or
+// shorter than its size when read.
 inline std::string read_regular_file(const std::filesystem::path& path, const std::string& element = "",
                                      std::string_view kind = "file") {
     std::error_code error;
@@ -34,6 +37,10 @@ inline std::string read_regular_file(const std::filesystem::path& path, const st
     const std::streamoff size = stream.tellg();
     stream.seekg(0, std::ios::beg);
     if (size < 0 || !stream) throw LoadError(path, element, "cannot read the " + std::string(kind));
+    if (std::uint64_t(size) > max_file_bytes)
+        throw LoadError(path, element,
+                        "the " + std::string(kind) + " is " + std::to_string(std::uint64_t(size) >> 20) +
+                            " MiB; prism reads at most " + std::to_string(max_file_bytes >> 20) + " MiB");
     std::string bytes(static_cast<std::size_t>(size), '\0');
     if (!stream.read(bytes.data(), size)) throw LoadError(path, element, "cannot read the " + std::string(kind));
     return bytes;
