@@ -172,6 +172,19 @@ TEST_CASE("cameras whose films would need more memory than the limit are refused
     CHECK(contains(message, "the scene's films reach 3 MiB here (this one 512 x 512): about 3 MiB to render"));
 }
 
+TEST_CASE("a Perlin texture's NumOctaves past the limit is refused (each is a noise evaluation a lookup)") {
+    const auto perlin = [](const std::string& octaves) {
+        return scene_text("<Textures><TextureMap id=\"1\" type=\"perlin\"><DecalMode>replace_kd</DecalMode>"
+                          "<NumOctaves>" + octaves + "</NumOctaves></TextureMap></Textures>");
+    };
+    CHECK(load_text(perlin(std::to_string(prism::io::max_noise_octaves))).textures.size() == 1);
+    for (const std::string& over : {std::to_string(prism::io::max_noise_octaves + 1), std::string("2147483647")}) {
+        const std::string message = refusal([&] { load_text(perlin(over)); });
+        CHECK(contains(message, "<NumOctaves>"));
+        CHECK(contains(message, over + " is over prism's limit of " + std::to_string(prism::io::max_noise_octaves)));
+    }
+}
+
 TEST_CASE("200,000 nested elements are refused in XML and JSON, without recursion that deep") {
     const int depth = 200000;
     std::string nested;

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <random>
@@ -257,6 +258,28 @@ TEST_CASE_TEMPLATE("Perlin: the course's form equals Perlin 2002's lerps, is fix
     CHECK(high <= 1);
     CHECK(low < -0.5);  // the noise spans its range, not a constant
     CHECK(high > 0.5);
+}
+
+// A high octave doubles the coordinate each time, and a far scene starts far: a cell's number past
+// an int's range was converted with undefined behaviour (the sanitized build runs this test).
+// The gradients depend on a number only through its sign and its remainder modulo 16.
+TEST_CASE_TEMPLATE("Perlin: cells past an int's range take the gradients of their sign and remainder", Real, float, double) {
+    using Noise = PerlinNoise<Real>;
+    const Real y = Real(0.25), z = Real(0.75);
+    for (const Real far : {Real(1e12), Real(-1e12), Real(3e15), std::ldexp(Real(1), 40) + 5, -std::ldexp(Real(1), 40) - 7}) {
+        // A float or double this large is a whole number: its cell is itself, its offset 0.
+        REQUIRE(std::floor(far) == far);
+        const Real rest = std::fmod(std::abs(far), Real(16));
+        const Real near = std::copysign(Real(1 << 20) + rest, far);  // held by an int, the same remainder and sign
+        CHECK(Noise::noise({far, y, z}) == Noise::noise({near, y, z}));
+        CHECK(Noise::noise({y, far, z}) == Noise::noise({y, near, z}));
+        CHECK(Noise::noise({y, z, far}) == Noise::noise({y, z, near}));
+    }
+    // Sixty-four octaves (the loader's limit) reach 2^63 times the point: finite.
+    CHECK(std::isfinite(Noise::fractal({Real(0.3), Real(0.7), Real(-0.1)}, 64)));
+    // Infinity and NaN give NaN, without undefined behaviour.
+    CHECK(std::isnan(Noise::noise({std::numeric_limits<Real>::infinity(), y, z})));
+    CHECK(std::isnan(Noise::noise({std::numeric_limits<Real>::quiet_NaN(), y, z})));
 }
 
 TEST_CASE_TEMPLATE("Perlin: the shared weights and hashes give the corner-by-corner sum bit for bit", Real, float, double) {

@@ -157,7 +157,7 @@ private:
                 reader_.keyword<scene::NoiseConversion>(*e, "noise conversion", {{"absval", absval}, {"linear", linear}});
         }
         if (const Element* e = element.child("NoiseScale")) texture.noise_scale = reader_.positive(*e);
-        if (const Element* e = element.child("NumOctaves")) texture.num_octaves = int(reader_.integer_at_least(*e, 1));
+        if (const Element* e = element.child("NumOctaves")) texture.num_octaves = int(reader_.integer_within_limit(*e, 1, max_noise_octaves));
         if (const Element* e = element.child("Scale")) texture.scale = reader_.positive(*e);
         return texture;
     }

@@ -108,7 +108,20 @@ private:
     static Axis axis(Real coordinate) {
         const Real cell = std::floor(coordinate);
         const Real f = coordinate - cell;  // position in the cell, [0, 1)
-        return {int(cell), {f, f - 1}, {weight(f), weight(f - 1)}};
+        return {cell_number(cell), {f, f - 1}, {weight(f), weight(f - 1)}};
+    }
+
+    // A cell's number as an int. Past 2^30 (a far point, or a high octave: each doubles the
+    // coordinate) the int could not hold it, and converting it was undefined behaviour, as were
+    // infinity and NaN. phi reads a number n only through |n| % 16, and corner_gradients reads
+    // n + 0 to n + 16 at most, so a number replaced by one of its sign and remainder, 32 to 47
+    // from zero, gives every corner the gradient it had: the same bits wherever the int held it.
+    static int cell_number(Real cell) {
+        constexpr Real far = Real(1 << 30);
+        if (std::abs(cell) < far) return int(cell);
+        if (!std::isfinite(cell)) return 32;  // NaN or infinity: the noise is NaN (its offset is)
+        const int rest = int(std::fmod(std::abs(cell), Real(16)));
+        return cell > 0 ? 32 + rest : -(32 + rest);
     }
 
     // The gradient numbers of a cell's 8 corners (corner = di + 2 dj + 4 dk).
