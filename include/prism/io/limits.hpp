@@ -38,8 +38,9 @@ inline constexpr std::int64_t max_image_pixels = std::int64_t(1) << 27;
 inline constexpr std::uint64_t max_file_bytes = std::uint64_t(1) << 31;
 
 // A Perlin texture's NumOctaves: each octave is one more noise evaluation a lookup (a file asking
-// for 2^31 - 1 of them never finished rendering), and past 53 an octave's weight, 2^-53 of the
-// first's, is below what a double holds of their sum. The course's files give none (1).
+// for 2^31 - 1 of them had not rendered 16 x 16 pixels after 30 s), and past 53 an octave's
+// weight, 2^-53 of the first's, is below what a double holds of their sum. The course's files
+// give none (1).
 inline constexpr long long max_noise_octaves = 64;
 
 // Samples per pixel: the course's most is 2500.
