@@ -208,6 +208,48 @@ TEST_CASE("200,000 nested elements are refused in XML and JSON, without recursio
     CHECK(prism::io::parse_xml(deepest + "</Scene>", "scene.xml").children.size() == 1);
 }
 
+// Elements and attributes cost some 200 bytes each to read, 40-60 times their size in the file, so
+// they are counted before the tree is built (XML: before pugixml builds its own) and a file past
+// max_scene_nodes is refused: 16 million `<a/>` (64 MB) took 3.6 GB to read before.
+TEST_CASE("a scene file's elements and attributes are counted and refused past the limit") {
+    const auto nodes_refused = [](const std::string& message, std::uint64_t limit) {
+        return contains(message, "the file holds more than " + std::to_string(limit) + " elements and attributes");
+    };
+    SUBCASE("XML: start tags and their attributes count; end tags, comments, CDATA and declarations do not") {
+        // 9 nodes: Scene, Objects, Sphere and its id, Material, Center, Radius, Group and its attribute
+        // (one, though its value holds '=').
+        const std::string text =
+            "<?xml version=\"1.0\"?>\n<!DOCTYPE Scene>\n<Scene><!-- <a/><b/> -->\n<Objects>\n"
+            "<Sphere id=\"1\"><Material>1</Material><Center>1</Center><Radius><![CDATA[<c/>]]>1</Radius></Sphere>\n"
+            "</Objects><Group name='a=b'/></Scene>";
+        CHECK(prism::io::parse_xml(text, "scene.xml", 9).children.size() == 2);
+        CHECK(nodes_refused(refusal([&] { prism::io::parse_xml(text, "scene.xml", 8); }), 8));
+        // The seventh node, Radius, passes a limit of 6: named inside the elements still open, at its line.
+        const std::string message = refusal([&] { prism::io::parse_xml(text, "scene.xml", 6); });
+        CHECK(contains(message, "scene.xml: <Objects>/<Sphere id=\"1\"> (line 5): "));
+        CHECK(nodes_refused(message, 6));
+    }
+    SUBCASE("XML at prism's limit: refused before any tree is built") {
+        std::string text = "<Scene>";
+        text.reserve(4 * std::size_t(prism::io::max_scene_nodes) + 16);
+        for (std::uint64_t i = 1; i < prism::io::max_scene_nodes; ++i) text += "<a/>";
+        CHECK(prism::io::detail::xml::where_nodes_pass(text, prism::io::max_scene_nodes) == std::string::npos);
+        text += "<a/></Scene>";
+        const std::string message = refusal([&] { prism::io::parse_xml(text, "scene.xml"); });
+        CHECK(contains(message, "scene.xml: <Scene> (line 1): "));
+        CHECK(nodes_refused(message, prism::io::max_scene_nodes));
+    }
+    SUBCASE("JSON: objects, values and attributes count; the document around the root does not") {
+        // 7 nodes: Scene, Objects, Sphere, its _id, Material, and the two Radius values of an array.
+        const std::string text = R"({"Scene": {"Objects": {"Sphere": {"_id": "1", "Material": "1"}}, "Radius": ["1", "2"]}})";
+        CHECK(prism::io::parse_json(text, "scene.json", 7).children.size() == 3);
+        const std::string message = refusal([&] { prism::io::parse_json(text, "scene.json", 6); });
+        CHECK(contains(message, "scene.json: <Scene>: "));
+        CHECK(nodes_refused(message, 6));
+        CHECK(nodes_refused(refusal([&] { prism::io::parse_json(text, "scene.json", 3); }), 3));
+    }
+}
+
 TEST_CASE("a chain of 20,000 MeshInstances, each naming the next, resolves without recursion") {
     // Written from the end of the chain back to the mesh: each instance's base comes after it.
     const int count = 20000;
@@ -359,6 +401,14 @@ TEST_CASE("read_regular_file: a regular file's bytes; no pipe, device or folder 
         refused(huge, "image file", "the image file is 2048 MiB; prism reads at most 2048 MiB");
         std::filesystem::resize_file(huge, 3 * prism::io::max_file_bytes);
         refused(huge, "image file", "the image file is 6144 MiB; prism reads at most 2048 MiB");
+    }
+    SUBCASE("a scene file larger than prism reads as a scene, refused before it is read") {
+        for (const char* name : {"huge.xml", "huge.json"}) {
+            const std::filesystem::path huge = folder.write(name, "");
+            std::filesystem::resize_file(huge, prism::io::max_scene_file_bytes + 1);
+            const std::string message = refusal([&] { prism::io::load_scene(huge); });
+            CHECK(message == huge.string() + ": the scene file is 256 MiB; prism reads at most 256 MiB");
+        }
     }
     SUBCASE("a named pipe, by each reader") {
         const std::filesystem::path pipe = folder.path() / "pipe";

@@ -22,17 +22,52 @@
 
 namespace prism::io::detail::scene_loader {
 
-inline std::vector<std::string_view> split_words(std::string_view text) {
-    std::vector<std::string_view> words;
-    std::size_t i = 0;
-    while (i < text.size()) {
-        while (i < text.size() && Element::is_blank(text[i])) ++i;
-        const std::size_t start = i;
-        while (i < text.size() && !Element::is_blank(text[i])) ++i;
-        if (i > start) words.push_back(text.substr(start, i - start));
+// The blank-separated words of `text`, found as they are read: a list of millions of numbers
+// (inline VertexData, Faces) is not first copied into as many views, 16 bytes a word.
+class Words {
+public:
+    class iterator {
+    public:
+        using value_type = std::string_view;
+        using difference_type = std::ptrdiff_t;
+        iterator() = default;
+        iterator(std::string_view text, std::size_t from) : text_(text) { find(from); }
+        std::string_view operator*() const { return text_.substr(start_, end_ - start_); }
+        iterator& operator++() {
+            find(end_);
+            return *this;
+        }
+        iterator operator++(int) {
+            iterator before = *this;
+            ++*this;
+            return before;
+        }
+        bool operator==(const iterator& other) const { return start_ == other.start_; }
+
+    private:
+        void find(std::size_t from) {
+            while (from < text_.size() && Element::is_blank(text_[from])) ++from;
+            start_ = end_ = from;
+            while (end_ < text_.size() && !Element::is_blank(text_[end_])) ++end_;
+        }
+        std::string_view text_;
+        std::size_t start_ = 0, end_ = 0;  // the word's bytes; start_ == text_.size() at the end
+    };
+
+    explicit Words(std::string_view text) : text_(text) {}
+    iterator begin() const { return {text_, 0}; }
+    iterator end() const { return {text_, text_.size()}; }
+    std::size_t count() const {
+        std::size_t words = 0;
+        for (iterator word = begin(), last = end(); word != last; ++word) ++words;
+        return words;
     }
-    return words;
-}
+
+private:
+    std::string_view text_;
+};
+
+inline Words split_words(std::string_view text) { return Words(text); }
 
 inline std::string_view trim(std::string_view text) {
     while (!text.empty() && Element::is_blank(text.front())) text.remove_prefix(1);
@@ -110,8 +145,10 @@ public:
     }
 
     std::vector<double> numbers(const Element& element) const {
+        const Words words = split_words(element.text);
         std::vector<double> values;
-        for (std::string_view word : split_words(element.text)) values.push_back(parse_number(element, word));
+        values.reserve(words.count());  // counted first: the list is not grown and copied as it is read
+        for (std::string_view word : words) values.push_back(parse_number(element, word));
         return values;
     }
 
@@ -147,15 +184,18 @@ public:
     }
 
     std::vector<long long> integers(const Element& element) const {
+        const Words words = split_words(element.text);
         std::vector<long long> values;
-        for (std::string_view word : split_words(element.text)) values.push_back(parse_integer(element, word));
+        values.reserve(words.count());
+        for (std::string_view word : words) values.push_back(parse_integer(element, word));
         return values;
     }
 
     long long integer(const Element& element) const {
-        const std::vector<std::string_view> words = split_words(element.text);
-        if (words.size() != 1) fail(element, "expected 1 integer, found " + std::to_string(words.size()) + " values");
-        return parse_integer(element, words[0]);
+        const Words words = split_words(element.text);
+        if (const std::size_t count = words.count(); count != 1)
+            fail(element, "expected 1 integer, found " + std::to_string(count) + " values");
+        return parse_integer(element, *words.begin());
     }
 
     long long integer_at_least(const Element& element, long long minimum) const {

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -29,6 +30,9 @@ class TreeBuilder {
 public:
     using Json = nlohmann::json;
 
+    // At most `max_nodes` elements and attributes (limits.hpp): each object and value is one.
+    explicit TreeBuilder(std::uint64_t max_nodes = max_scene_nodes) : max_nodes_(max_nodes) {}
+
     // null is an empty element (`<TexCoordData/>`), the same as "".
     bool null() { return add_value(""); }
     bool boolean(bool value) { return add_value(value ? "true" : "false"); }
@@ -40,7 +44,8 @@ public:
     bool binary(Json::binary_t&) { return fail("binary values have no meaning in a scene file"); }
 
     bool start_object(std::size_t) {
-        if (too_deep()) return false;
+        // The unnamed document around the root is no element of the scene's.
+        if (too_deep() || (!stack_.empty() && too_many())) return false;
         std::string name;
         if (!stack_.empty()) {
             const Frame& top = stack_.back();
@@ -132,6 +137,7 @@ private:
 
     bool add_value(std::string value) {
         if (stack_.empty()) return fail("the file must hold a JSON object");
+        if (too_many()) return false;
         Frame& top = stack_.back();
         if (top.is_array) {
             parent_object().children.push_back(named(top.name, std::move(value)));
@@ -158,6 +164,15 @@ private:
         return true;
     }
 
+    // Elements and attributes are counted as the tree grows; nlohmann's SAX parser keeps no tree
+    // of its own, so this bounds the memory the file can ask for while it is read.
+    bool too_many() {
+        if (++nodes_ <= max_nodes_) return false;
+        fail("the file holds more than " + std::to_string(max_nodes_) +
+             " elements and attributes, prism's limit (each costs some 200 bytes to read)");
+        return true;
+    }
+
     bool fail(std::string message) {
         error_ = std::move(message);
         error_path_ = current_path();
@@ -176,6 +191,8 @@ private:
         return path;
     }
 
+    std::uint64_t max_nodes_;
+    std::uint64_t nodes_ = 0;
     std::vector<Frame> stack_;
     Element document_;
     std::string error_;
@@ -185,12 +202,14 @@ private:
 }  // namespace detail::json
 
 // Parses a scene file's contents already in memory; `path` names the file in messages.
-inline Element parse_json(std::string_view contents, const std::filesystem::path& path) {
-    detail::json::TreeBuilder builder;
+// At most `max_nodes` elements and attributes (limits.hpp).
+inline Element parse_json(std::string_view contents, const std::filesystem::path& path,
+                          std::uint64_t max_nodes = max_scene_nodes) {
+    detail::json::TreeBuilder builder(max_nodes);
     if (!nlohmann::json::sax_parse(contents, &builder)) throw LoadError(path, builder.error_path(), builder.error());
     return builder.take_root(path);
 }
 
-inline Element read_json(const std::filesystem::path& path) { return parse_json(read_regular_file(path, "", "scene file"), path); }
+inline Element read_json(const std::filesystem::path& path) { return parse_json(read_regular_file(path, "", "scene file", max_scene_file_bytes), path); }
 
 }  // namespace prism::io

@@ -37,6 +37,20 @@ inline constexpr std::int64_t max_image_pixels = std::int64_t(1) << 27;
 // million triangles, which take more than 17 GB to render.
 inline constexpr std::uint64_t max_file_bytes = std::uint64_t(1) << 31;
 
+// A scene file's text is held three times while it is read (the file's bytes, pugixml's copy,
+// each element's text) and its numbers twice more (parsed, then made vertices): 100 MB of
+// inline VertexData took 1.4 GB. The course's largest scene file is 2.1 MB (a JSON file with its
+// meshes inline); meshes beyond a few million triangles belong in PLY or binary files, which are
+// read without the element tree.
+inline constexpr std::uint64_t max_scene_file_bytes = std::uint64_t(1) << 28;
+
+// Elements and attributes in a scene file: each costs 160-230 bytes of memory as it is read
+// (pugixml's node, the element tree's Element, its path), 40-60 times the few bytes it takes in
+// the file: 16 million empty elements (`<a/>`, 64 MB) took 3.6 GB, and a file of the 2 GiB a
+// file may hold would have taken some 120 GB. They are counted before pugixml builds its tree
+// (XML) and as the tree is built (JSON). The course's files hold at most 673 (tower.xml).
+inline constexpr std::uint64_t max_scene_nodes = std::uint64_t(1) << 22;
+
 // A Perlin texture's NumOctaves: each octave is one more noise evaluation a lookup (a file asking
 // for 2^31 - 1 of them had not rendered 16 x 16 pixels after 30 s), and past 53 an octave's
 // weight, 2^-53 of the first's, is below what a double holds of their sum. The course's files

@@ -21,10 +21,10 @@ namespace prism::io {
 // The bytes of `path`; `element` is the scene element that named it (empty for a file named on
 // its own), `kind` what the messages call it ("image file": "no such image file"). Throws
 // LoadError naming the file, the element and what is wrong: absent, a folder, not a regular
-// file (a device, a pipe, a socket), larger than max_file_bytes (limits.hpp), unreadable, or
-// shorter than its size when read.
+// file (a device, a pipe, a socket), larger than `max_bytes` (limits.hpp: max_file_bytes, or
+// max_scene_file_bytes for a scene file's text), unreadable, or shorter than its size when read.
 inline std::string read_regular_file(const std::filesystem::path& path, const std::string& element = "",
-                                     std::string_view kind = "file") {
+                                     std::string_view kind = "file", std::uint64_t max_bytes = max_file_bytes) {
     std::error_code error;
     const std::filesystem::file_status status = std::filesystem::status(path, error);
     if (status.type() == std::filesystem::file_type::not_found) throw LoadError(path, element, "no such " + std::string(kind));
@@ -37,10 +37,10 @@ inline std::string read_regular_file(const std::filesystem::path& path, const st
     const std::streamoff size = stream.tellg();
     stream.seekg(0, std::ios::beg);
     if (size < 0 || !stream) throw LoadError(path, element, "cannot read the " + std::string(kind));
-    if (std::uint64_t(size) > max_file_bytes)
+    if (std::uint64_t(size) > max_bytes)
         throw LoadError(path, element,
                         "the " + std::string(kind) + " is " + std::to_string(std::uint64_t(size) >> 20) +
-                            " MiB; prism reads at most " + std::to_string(max_file_bytes >> 20) + " MiB");
+                            " MiB; prism reads at most " + std::to_string(max_bytes >> 20) + " MiB");
     std::string bytes(static_cast<std::size_t>(size), '\0');
     if (!stream.read(bytes.data(), size)) throw LoadError(path, element, "cannot read the " + std::string(kind));
     return bytes;

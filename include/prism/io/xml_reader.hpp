@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -21,26 +22,32 @@ namespace prism::io {
 
 namespace detail::xml {
 
-// Maps byte offsets to 1-based line numbers; pugixml only knows offsets.
+// Maps byte offsets to 1-based line numbers; pugixml only knows offsets. The elements are asked
+// for in document order, so the count of newlines goes forward from the last offset asked (an
+// earlier one, for a message, counts from the start): no table of line starts, which a file of
+// newlines would have made eight times its size.
 class LineTable {
 public:
-    explicit LineTable(std::string_view text) {
-        line_starts_.push_back(0);
-        for (std::size_t i = 0; i < text.size(); ++i)
-            if (text[i] == '\n') line_starts_.push_back(i + 1);
-    }
-    int line(std::ptrdiff_t offset) const {
+    explicit LineTable(std::string_view text) : text_(text) {}
+    int line(std::ptrdiff_t offset) {
         if (offset < 0) return 0;
-        const auto next = std::upper_bound(line_starts_.begin(), line_starts_.end(), std::size_t(offset));
-        return int(next - line_starts_.begin());
+        const std::size_t to = std::min(std::size_t(offset), text_.size());
+        if (to < counted_) counted_ = 0, line_ = 1;
+        line_ += std::count(text_.begin() + std::ptrdiff_t(counted_), text_.begin() + std::ptrdiff_t(to), '\n');
+        counted_ = to;
+        return int(line_);
     }
     int column(std::ptrdiff_t offset) const {
         if (offset < 0) return 0;
-        return int(std::size_t(offset) - line_starts_[std::size_t(line(offset) - 1)]) + 1;
+        const std::size_t to = std::min(std::size_t(offset), text_.size());
+        const std::size_t newline = to == 0 ? std::string_view::npos : text_.rfind('\n', to - 1);
+        return int(to - (newline == std::string_view::npos ? 0 : newline + 1)) + 1;
     }
 
 private:
-    std::vector<std::size_t> line_starts_;
+    std::string_view text_;
+    std::size_t counted_ = 0;  // newlines are counted up to here
+    std::ptrdiff_t line_ = 1;  // the line of offset counted_
 };
 
 // The id attribute's value inside a start tag's text (`Mesh id="3" shadingMode="smooth"`).
@@ -61,10 +68,14 @@ inline const std::string* find_id(std::string_view tag, std::string& storage) {
     return nullptr;
 }
 
-// The path of the elements still open at `offset`, found by a small tag scanner: pugixml reports
-// where a malformed file goes wrong but not inside which element, which is what a user needs.
-inline std::string open_elements_at(std::string_view text, std::size_t offset) {
-    std::vector<std::string> open;
+// Calls visit(start, tag, attributes) for each tag of `text` that opens before `offset`, in
+// order: `start` is the offset of its '<', `tag` what lies between '<' and '>', `attributes` the
+// count of '=' outside quotes in it. Comments, CDATA sections, processing instructions and the
+// DOCTYPE are skipped. Stops where visit returns false, at `offset`, or at a tag that does not
+// close (where a malformed file goes wrong). A small scanner of its own, since pugixml reports
+// neither inside which element a fault lies nor how many nodes it is about to build.
+template <class Visit>
+void scan_tags(std::string_view text, std::size_t offset, Visit visit) {
     std::size_t i = 0;
     const auto skip_past = [&](std::size_t from, std::string_view terminator) {
         const std::size_t end = text.find(terminator, from);
@@ -72,13 +83,13 @@ inline std::string open_elements_at(std::string_view text, std::size_t offset) {
     };
     while (i < offset) {
         const std::size_t start = text.find('<', i);
-        if (start == std::string_view::npos || start >= offset) break;
+        if (start == std::string_view::npos || start >= offset) return;
         const std::string_view rest = text.substr(start);
         if (rest.starts_with("<!--")) { i = skip_past(start + 4, "-->"); continue; }
         if (rest.starts_with("<![CDATA[")) { i = skip_past(start + 9, "]]>"); continue; }
         if (rest.starts_with("<?")) { i = skip_past(start + 2, "?>"); continue; }
         if (rest.starts_with("<!")) { i = skip_past(start + 2, ">"); continue; }
-        std::size_t end = start + 1;
+        std::size_t end = start + 1, attributes = 0;
         char quote = 0;
         for (; end < text.size(); ++end) {
             const char c = text[end];
@@ -86,13 +97,23 @@ inline std::string open_elements_at(std::string_view text, std::size_t offset) {
                 if (c == quote) quote = 0;
             } else if (c == '"' || c == '\'') {
                 quote = c;
+            } else if (c == '=') {
+                ++attributes;
             } else if (c == '>' || c == '<') {
                 break;
             }
         }
-        // A tag that does not close before the fault is where the fault is: its parents are open.
-        if (end >= text.size() || text[end] != '>' || end >= offset) break;
-        const std::string_view tag = text.substr(start + 1, end - start - 1);
+        if (end >= text.size() || text[end] != '>' || end >= offset) return;
+        if (!visit(start, text.substr(start + 1, end - start - 1), attributes)) return;
+        i = end + 1;
+    }
+}
+
+// The path of the elements still open at `offset`: what a user needs to find a fault.
+inline std::string open_elements_at(std::string_view text, std::size_t offset) {
+    std::vector<std::string> open;
+    // A tag that does not close before the fault is where the fault is: its parents are open.
+    scan_tags(text, offset, [&](std::size_t, std::string_view tag, std::size_t) {
         if (tag.starts_with('/')) {
             if (!open.empty()) open.pop_back();
         } else if (!tag.ends_with('/')) {
@@ -101,8 +122,8 @@ inline std::string open_elements_at(std::string_view text, std::size_t offset) {
             std::string id;
             open.push_back(element_label(tag.substr(0, name_end), find_id(tag, id)));
         }
-        i = end + 1;
-    }
+        return true;
+    });
     // Paths leave the root out (see assign_paths), unless it is all there is.
     if (open.size() == 1) return open.front();
     std::string path;
@@ -110,8 +131,24 @@ inline std::string open_elements_at(std::string_view text, std::size_t offset) {
     return path;
 }
 
+// The offset of the start tag at which the file's elements and attributes pass `limit`, or
+// npos if they do not. Counted before pugixml builds its tree, which would cost the memory the
+// limit is there to bound.
+inline std::size_t where_nodes_pass(std::string_view text, std::uint64_t limit) {
+    std::uint64_t nodes = 0;
+    std::size_t passed = std::string_view::npos;
+    scan_tags(text, text.size(), [&](std::size_t start, std::string_view tag, std::size_t attributes) {
+        if (tag.starts_with('/')) return true;
+        nodes += 1 + attributes;
+        if (nodes <= limit) return true;
+        passed = start;
+        return false;
+    });
+    return passed;
+}
+
 // Recursive, so the depth is checked first: the file must not choose how deep the stack goes.
-inline Element convert(const pugi::xml_node& node, const LineTable& lines, const std::filesystem::path& path,
+inline Element convert(const pugi::xml_node& node, LineTable& lines, const std::filesystem::path& path,
                        int depth = 1) {
     Element element;
     element.name = node.name();
@@ -136,8 +173,17 @@ inline Element convert(const pugi::xml_node& node, const LineTable& lines, const
 }  // namespace detail::xml
 
 // Parses a scene file's contents already in memory; `path` names the file in messages.
-inline Element parse_xml(std::string_view contents, const std::filesystem::path& path) {
-    const detail::xml::LineTable lines(contents);
+// At most `max_nodes` elements and attributes (limits.hpp).
+inline Element parse_xml(std::string_view contents, const std::filesystem::path& path,
+                         std::uint64_t max_nodes = max_scene_nodes) {
+    detail::xml::LineTable lines(contents);
+    if (const std::size_t passed = detail::xml::where_nodes_pass(contents, max_nodes); passed != std::string_view::npos) {
+        std::string where = detail::xml::open_elements_at(contents, passed + 1);
+        where += (where.empty() ? "(line " : " (line ") + std::to_string(lines.line(std::ptrdiff_t(passed))) + ")";
+        throw LoadError(path, where,
+                        "the file holds more than " + std::to_string(max_nodes) +
+                            " elements and attributes, prism's limit (each costs some 200 bytes to read)");
+    }
     pugi::xml_document document;
     const pugi::xml_parse_result result = document.load_buffer(contents.data(), contents.size());
     if (!result) {
@@ -153,6 +199,6 @@ inline Element parse_xml(std::string_view contents, const std::filesystem::path&
     return tree;
 }
 
-inline Element read_xml(const std::filesystem::path& path) { return parse_xml(read_regular_file(path, "", "scene file"), path); }
+inline Element read_xml(const std::filesystem::path& path) { return parse_xml(read_regular_file(path, "", "scene file", max_scene_file_bytes), path); }
 
 }  // namespace prism::io
