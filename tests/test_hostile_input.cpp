@@ -302,6 +302,23 @@ TEST_CASE("confined_output_path: image names stay inside the output folder") {
     CHECK(place("to_inside/image.png") == out / "to_inside/image.png");
     CHECK(contains(refusal([&] { place("to_outside/image.png"); }), "through a link"));
     CHECK(contains(refusal([&] { place("dangling/image.png"); }), "points nowhere"));
+
+    // Names the file system cannot hold are refused as such, quoted by their two ends.
+    const std::string long_part = refusal([&] { place(std::string(300, 'a') + ".png"); });
+    CHECK(contains(long_part, "\"" + std::string(120, 'a') + "..." + std::string(56, 'a') + ".png\" cannot be written under "
+                              "--output-dir: a part of it is longer than the 255 bytes of a file name"));
+    std::string deep;
+    for (int i = 0; i < 3000; ++i) deep += "d/";
+    const std::string long_path = refusal([&] { place(deep + "image.png"); });
+    CHECK(contains(long_path, "cannot be written under --output-dir: the path is longer than the 4095 bytes of a path"));
+    // The longest name a file may have is written, through a temporary file of a name as long.
+    const std::string longest = std::string(251, 'a') + ".png";
+    CHECK(place(longest) == out / longest);
+    prism::write_image(out / longest, prism::Image(1, 1));
+    CHECK(std::filesystem::file_size(out / longest) > 0);
+    // No temporary file is left beside it: the folder holds the four links and folders and the image.
+    CHECK(std::distance(std::filesystem::directory_iterator(out), std::filesystem::directory_iterator()) == 5);
+    CHECK(long_path.size() < 400);
 }
 
 TEST_CASE("decode_image refuses an image past the size limits before decoding it") {

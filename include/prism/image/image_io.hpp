@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <climits>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -63,9 +64,14 @@ inline std::string lowercase_extension(const std::filesystem::path& path) {
 // file system (and is therefore atomic). Process id and a counter keep concurrent writers apart.
 inline std::filesystem::path temporary_sibling(const std::filesystem::path& path) {
     static std::atomic<unsigned> counter{0};
+    const std::string suffix = "." + std::to_string(::getpid()) + "." + std::to_string(counter++) + ".tmp";
+    // The name is cut from its start where the whole would pass a file name's NAME_MAX bytes: an
+    // image name of 250 bytes is allowed (io::confined_output_path), and its temporary file
+    // must be too.
+    std::string name = path.filename().string();
+    if (1 + name.size() + suffix.size() > NAME_MAX) name.erase(0, 1 + name.size() + suffix.size() - NAME_MAX);
     std::filesystem::path temporary = path;
-    temporary.replace_filename("." + path.filename().string() + "." + std::to_string(::getpid()) + "." +
-                               std::to_string(counter++) + ".tmp");
+    temporary.replace_filename("." + name + suffix);
     return temporary;
 }
 

@@ -7,6 +7,7 @@
 
 #include <prism/io/load_error.hpp>
 
+#include <climits>
 #include <filesystem>
 #include <string>
 #include <system_error>
@@ -18,14 +19,27 @@ namespace prism::io {
 inline std::filesystem::path confined_output_path(const std::filesystem::path& output_dir,
                                                   const std::filesystem::path& image_name,
                                                   const std::filesystem::path& scene_file, const std::string& element) {
+    // A name of kilobytes is quoted by its two ends: the message stays one readable line.
+    const std::string& written = image_name.native();
+    const std::string quoted =
+        "\"" + (written.size() <= 200 ? written : written.substr(0, 120) + "..." + written.substr(written.size() - 60)) + "\"";
     const auto refuse = [&](const std::string& why) {
-        return LoadError(scene_file, element, "\"" + image_name.string() + "\" " + why +
-                                                  ": images are written inside --output-dir only");
+        return LoadError(scene_file, element, quoted + " " + why + ": images are written inside --output-dir only");
     };
     if (image_name.has_root_name() || image_name.has_root_directory()) throw refuse("is an absolute path");
     const std::filesystem::path normal = image_name.lexically_normal();
     if (normal.empty() || !normal.has_filename() || normal == ".") throw refuse("names no file");
     if (*normal.begin() == "..") throw refuse("leaves the output folder");
+    // Checked here, whether or not the folders exist yet, rather than found by the writer after
+    // the render: a part longer than a file name may be, a path longer than a path may be.
+    const auto unwritable = [&](const std::string& why) {
+        return LoadError(scene_file, element, quoted + " cannot be written under --output-dir: " + why);
+    };
+    for (const std::filesystem::path& component : normal)
+        if (component.native().size() > NAME_MAX)
+            throw unwritable("a part of it is longer than the " + std::to_string(NAME_MAX) + " bytes of a file name");
+    if ((output_dir / normal).native().size() >= PATH_MAX)
+        throw unwritable("the path is longer than the " + std::to_string(PATH_MAX - 1) + " bytes of a path");
 
     // A symbolic link inside the folder (`out/link -> /etc`) leaves it too: every link on the way
     // must resolve, and resolve inside the folder. A dangling link is refused: the writer would
@@ -45,8 +59,10 @@ inline std::filesystem::path confined_output_path(const std::filesystem::path& o
         if (error) throw refuse("passes through a link that points nowhere");
         if (!inside_folder(real)) throw refuse("leaves the output folder through a link");
     }
-    if (!inside_folder(std::filesystem::weakly_canonical(output_dir / normal, error)) || error)
-        throw refuse("leaves the output folder");
+    // The system's own refusals are said as such, not as leaving the folder.
+    const std::filesystem::path resolved = std::filesystem::weakly_canonical(output_dir / normal, error);
+    if (error) throw unwritable(error.message());
+    if (!inside_folder(resolved)) throw refuse("leaves the output folder");
     return output_dir / normal;
 }
 
