@@ -23,6 +23,7 @@ list(APPEND PRISM_BAD_INPUTS
   "image_name_no_file.xml|image_name_no_file.xml|ImageName"
   "image_name_empty.xml|image_name_empty.xml|ImageName"
   "image_name_missing.xml|image_name_missing.xml|ImageName"
+  "image_name_format.xml|image_name_format.xml|ImageName>: \"out.bmp\": unsupported output format"
   "camera_unknown_type.xml|camera_unknown_type.xml|Camera"
   "near_plane_three_numbers.xml|near_plane_three_numbers.xml|NearPlane"
   "near_plane_no_area.xml|near_plane_no_area.xml|NearPlane"

@@ -165,9 +165,12 @@ int main(int argc, char** argv) {
         for (const prism::scene::Camera& camera : scene.cameras) {
             const std::string element = prism::io::element_label("Camera", &camera.id) + "/<ImageName>";
             paths.emplace_back();
-            for (const prism::CameraOutput& output : prism::camera_outputs(camera))
+            for (const prism::CameraOutput& output : prism::camera_outputs(camera)) {
                 paths.back().push_back(
                     prism::io::confined_output_path(arguments.output_dir, output.name, arguments.scene, element));
+                if (const std::optional<std::string> problem = prism::unwritable_format(output.name))
+                    throw prism::io::LoadError(arguments.scene, element, "\"" + output.name.string() + "\": " + *problem);
+            }
         }
 
         const std::size_t total_pixels = prism::total_pixels(scene, arguments.options);

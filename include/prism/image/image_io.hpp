@@ -114,14 +114,21 @@ inline bool write_encoded(const std::filesystem::path& path, const std::optional
 
 }  // namespace detail
 
+// Why write_image cannot write `path`'s format, or nothing when it can: its extension, in any
+// case, must be .png, .exr or .ppm. Callers that render check it first (prism checks every
+// camera's outputs before the render), so a name's typo costs no render time.
+inline std::optional<std::string> unwritable_format(const std::filesystem::path& path) {
+    const std::string extension = detail::lowercase_extension(path);
+    if (extension == ".png" || extension == ".exr" || extension == ".ppm") return std::nullopt;
+    return "unsupported output format '" + extension + "' (use .png, .exr or .ppm)";
+}
+
 // Writes `.png` or `.ppm` (8-bit, to_8bit) or `.exr` (linear float RGB). Missing parent folders are
 // created; the file appears whole or not at all (written to a temporary sibling, then renamed),
 // so a failed or interrupted write never leaves a truncated image that looks like a result.
 inline void write_image(const std::filesystem::path& path, const Image& image) {
     const std::string extension = detail::lowercase_extension(path);
-    if (extension != ".png" && extension != ".exr" && extension != ".ppm")
-        throw io::LoadError(path, "ImageName",
-                            "unsupported output format '" + extension + "' (use .png, .exr or .ppm)");
+    if (const std::optional<std::string> problem = unwritable_format(path)) throw io::LoadError(path, "ImageName", *problem);
     if (image.width <= 0 || image.height <= 0 ||
         image.pixels.size() != std::size_t(image.width) * std::size_t(image.height))
         throw io::LoadError(path, "ImageName", "the image is empty or its size does not match its pixels");
