@@ -18,6 +18,7 @@
 #include <doctest/doctest.h>
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cstdint>
 #include <filesystem>
@@ -319,6 +320,33 @@ TEST_CASE("confined_output_path: image names stay inside the output folder") {
     // No temporary file is left beside it: the folder holds the four links and folders and the image.
     CHECK(std::distance(std::filesystem::directory_iterator(out), std::filesystem::directory_iterator()) == 5);
     CHECK(long_path.size() < 400);
+}
+
+// prism prepares --output-dir before the render: a folder it cannot write in was found only when
+// the first image was written, after every camera had rendered.
+TEST_CASE("prepare_output_folder: created when missing, refused with the system's reason when unusable") {
+    const prism_test::TemporaryFolder folder;
+    const std::filesystem::path nested = folder.path() / "new/renders";
+    prism::io::prepare_output_folder(nested);
+    CHECK(std::filesystem::is_directory(nested));
+    CHECK(std::filesystem::is_empty(nested));  // the probe file is gone
+    prism::io::prepare_output_folder(nested);  // an existing folder is fine
+
+    const std::filesystem::path file = folder.write("file.png", "x");
+    CHECK(refusal([&] { prism::io::prepare_output_folder(file); }) ==
+          file.string() + ": cannot create the output folder: Not a directory");
+    CHECK(refusal([&] { prism::io::prepare_output_folder(file / "sub"); }) ==
+          (file / "sub").string() + ": cannot create the output folder: Not a directory");
+    CHECK(std::filesystem::file_size(file) == 1);
+    // Without write permission (root writes anywhere, so only checked for another user).
+    if (::geteuid() != 0) {
+        const std::filesystem::path locked = folder.path() / "locked";
+        std::filesystem::create_directory(locked);
+        std::filesystem::permissions(locked, std::filesystem::perms::owner_read | std::filesystem::perms::owner_exec);
+        CHECK(refusal([&] { prism::io::prepare_output_folder(locked); }) ==
+              locked.string() + ": cannot write images in the output folder: Permission denied");
+        std::filesystem::permissions(locked, std::filesystem::perms::owner_all);
+    }
 }
 
 TEST_CASE("decode_image refuses an image past the size limits before decoding it") {

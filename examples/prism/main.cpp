@@ -173,6 +173,8 @@ int main(int argc, char** argv) {
             }
         }
 
+        prism::io::prepare_output_folder(arguments.output_dir);
+
         const std::size_t total_pixels = prism::total_pixels(scene, arguments.options);
         prism::ProgressBar progress(total_pixels, !arguments.quiet);
         // An exception thrown from a tile cancels the parallel render and reaches this thread.

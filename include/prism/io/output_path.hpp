@@ -7,10 +7,14 @@
 
 #include <prism/io/load_error.hpp>
 
+#include <cerrno>
 #include <climits>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <system_error>
+
+#include <unistd.h>
 
 namespace prism::io {
 
@@ -64,6 +68,31 @@ inline std::filesystem::path confined_output_path(const std::filesystem::path& o
     if (error) throw unwritable(error.message());
     if (!inside_folder(resolved)) throw refuse("leaves the output folder");
     return output_dir / normal;
+}
+
+// Creates `output_dir` if it is missing and proves that a file can be written in it (one is
+// created and removed), or throws a LoadError naming it and the system's reason. prism calls it
+// once the scene has loaded and before the render, which may take hours: a file in the
+// folder's place, a parent that cannot hold folders or a folder without write permission were
+// found only when the first image was written, after every camera had rendered. A scene that
+// then fails leaves the folder, and nothing in it.
+inline void prepare_output_folder(const std::filesystem::path& output_dir) {
+    const std::filesystem::path folder = output_dir.empty() ? std::filesystem::path(".") : output_dir;
+    std::error_code error;
+    std::filesystem::create_directories(folder, error);
+    if (error) throw LoadError(folder, "", "cannot create the output folder: " + error.message());
+    if (!std::filesystem::is_directory(folder, error))
+        throw LoadError(folder, "", "cannot be the output folder: it is not a folder");
+    const std::filesystem::path probe = folder / (".prism-probe." + std::to_string(::getpid()) + ".tmp");
+    {
+        std::ofstream file(probe, std::ios::binary);
+        if (!file) {
+            const int reason = errno;
+            throw LoadError(folder, "", "cannot write images in the output folder: " +
+                                            std::error_code(reason, std::generic_category()).message());
+        }
+    }
+    std::filesystem::remove(probe, error);
 }
 
 }  // namespace prism::io
