@@ -38,15 +38,15 @@ inline constexpr std::int64_t max_image_pixels = std::int64_t(1) << 27;
 inline constexpr std::uint64_t max_file_bytes = std::uint64_t(1) << 31;
 
 // A scene file's text is held three times while it is read (the file's bytes, pugixml's copy,
-// each element's text) and its numbers twice more (parsed, then made vertices): 100 MB of
-// inline VertexData took 1.4 GB. The course's largest scene file is 2.1 MB (a JSON file with its
-// meshes inline); meshes beyond a few million triangles belong in PLY or binary files, which are
-// read without the element tree.
+// each element's text) and its numbers twice more (parsed, then made vertices): 256 MiB of
+// inline VertexData takes 2.3 GiB (bench/RESULTS.md, "Reading scene files"). The course's
+// largest scene file is 2.1 MB (a JSON file with its meshes inline); meshes beyond a few million
+// triangles belong in PLY or binary files, which are read without the element tree.
 inline constexpr std::uint64_t max_scene_file_bytes = std::uint64_t(1) << 28;
 
 // Elements and attributes in a scene file: each costs 160-230 bytes of memory as it is read
 // (pugixml's node, the element tree's Element, its path), 40-60 times the few bytes it takes in
-// the file: 16 million empty elements (`<a/>`, 64 MB) took 3.6 GB, and a file of the 2 GiB a
+// the file: 16 million empty elements (`<a/>`, 64 MB) took 3.6 GiB, and a file of the 2 GiB a
 // file may hold would have taken some 120 GB. They are counted before pugixml builds its tree
 // (XML) and as the tree is built (JSON). The course's files hold at most 673 (tower.xml).
 inline constexpr std::uint64_t max_scene_nodes = std::uint64_t(1) << 22;
