@@ -186,6 +186,24 @@ TEST_CASE("a Perlin texture's NumOctaves past the limit is refused (each is a no
     }
 }
 
+TEST_CASE("an object's texture list past the limit is refused (each is applied at every shading point)") {
+    const auto textured = [](std::size_t count) {
+        std::string list;
+        for (std::size_t i = 0; i < count; ++i) list += (i > 0 ? " 1" : "1");
+        std::string text = scene_text("<Textures><TextureMap id=\"1\" type=\"perlin\"><DecalMode>replace_kd</DecalMode>"
+                                      "</TextureMap></Textures>");
+        text.insert(text.find("<Faces>"), "<Textures>" + list + "</Textures>");
+        return text;
+    };
+    CHECK(load_text(textured(prism::io::max_textures_per_object)).meshes.at(0).textures.size() ==
+          prism::io::max_textures_per_object);
+    for (const std::size_t over : {prism::io::max_textures_per_object + 1, std::size_t(100000)}) {
+        const std::string message = refusal([&] { load_text(textured(over)); });
+        CHECK(contains(message, "<Mesh id=\"1\">/<Textures>"));
+        CHECK(contains(message, "more than 64 textures for one object, prism's limit"));
+    }
+}
+
 TEST_CASE("200,000 nested elements are refused in XML and JSON, without recursion that deep") {
     const int depth = 200000;
     std::string nested;

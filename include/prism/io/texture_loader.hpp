@@ -85,6 +85,10 @@ public:
                 const auto found = texture_ids_.find(std::string(id));
                 if (found == texture_ids_.end()) reader_.fail(reference, "unknown texture id " + in_quotes(id));
                 indices.insert(indices.end(), found->second.begin(), found->second.end());
+                if (indices.size() > max_textures_per_object)
+                    reader_.fail(reference, "more than " + std::to_string(max_textures_per_object) +
+                                                " textures for one object, prism's limit (each is applied at every "
+                                                "shading point)");
             }
         }
         return indices;
