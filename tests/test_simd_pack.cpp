@@ -2,7 +2,8 @@
 // (a NaN distance constrains nothing), and sqrt, negation and >=, which the direct spheres'
 // test on several rays relies on for the scalar sphere test's bits. A faster form must keep
 // these bits. And select, lane by lane at every width the kernels use (clang 14 with libstdc++'s
-// AVX-512 masks got it wrong: simd/pack.hpp).
+// AVX-512 masks got it wrong: simd/pack.hpp). Widths beyond one register are two halves
+// (simd/pack.hpp, needs_halves): 16 floats and 8 doubles under AVX2.
 #include <prism/simd/pack.hpp>
 
 #include <doctest/doctest.h>
@@ -93,7 +94,50 @@ void check_select() {
     }
 }
 
+// A mask's bits (lane i is bit i), any, and its &, | and !, at widths one register holds and at
+// wider ones, which are two halves (simd/pack.hpp, needs_halves) on a target without them.
+template <class T, int N>
+void check_mask() {
+    using Pack = prism::simd::Pack<T, N>;
+    alignas(64) T a[N], b[N];
+    for (int pattern = 0; pattern < 12; ++pattern) {
+        for (int i = 0; i < N; ++i) {
+            a[i] = T((i * 5 + pattern) % 7);
+            b[i] = T((i * 3 + 2 * pattern) % 5);
+        }
+        // Pattern 0 leaves no lane below; the last lane alone is below in pattern 1.
+        if (pattern == 0)
+            for (int i = 0; i < N; ++i) b[i] = T(-1);
+        if (pattern == 1)
+            for (int i = 0; i < N; ++i) b[i] = i == N - 1 ? T(9) : T(-1);
+        const Pack pa = Pack::load(a), pb = Pack::load(b);
+        std::uint32_t below = 0, equal = 0;
+        for (int i = 0; i < N; ++i) {
+            below |= std::uint32_t(a[i] < b[i]) << i;
+            equal |= std::uint32_t(a[i] == b[i]) << i;
+        }
+        const std::uint32_t all = N == 32 ? ~std::uint32_t(0) : (std::uint32_t(1) << N) - 1;
+        CAPTURE(N);
+        CAPTURE(pattern);
+        CHECK((pa < pb).bits() == below);
+        CHECK((pa < pb).any() == (below != 0));
+        CHECK(((pa < pb) & (pa == pb)).bits() == 0);
+        CHECK(((pa < pb) | (pa == pb)).bits() == (below | equal));
+        CHECK((pa <= pb).bits() == (below | equal));
+        CHECK((!(pa < pb)).bits() == (~below & all));
+        CHECK((pa >= pb).bits() == (~below & all));
+        CHECK((pa != pb).bits() == (~equal & all));
+    }
+}
+
 }  // namespace
+
+TEST_CASE_TEMPLATE("a mask's bits, any, &, | and ! are each lane's, at every width", T, float, double) {
+    check_mask<T, 4>();
+    check_mask<T, 8>();
+    check_mask<T, 16>();
+    check_mask<T, 32>();
+}
 
 TEST_CASE_TEMPLATE("select is mask ? a : b in every lane, at every width", T, float, double) {
     check_select<T, 2>();
@@ -106,6 +150,7 @@ TEST_CASE_TEMPLATE("select is mask ? a : b in every lane, at every width", T, fl
 TEST_CASE_TEMPLATE("sqrt is std::sqrt's, -p and p >= q each lane's, to the bit", T, float, double) {
     check_sqrt_negation_compare<T, 4>();
     check_sqrt_negation_compare<T, 8>();
+    check_sqrt_negation_compare<T, 16>();
 }
 
 TEST_CASE_TEMPLATE("max_keep and min_keep are a > b ? a : b and a < b ? a : b, NaN and signed zeros included", T,

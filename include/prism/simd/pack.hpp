@@ -48,6 +48,7 @@ namespace stdx = std::experimental;
 
 template <class T, int N>
 struct Mask {
+    static constexpr bool split = false;
     using Native = stdx::simd_mask<T, stdx::simd_abi::deduce_t<T, N>>;
     Native native;
 
@@ -61,6 +62,7 @@ struct Mask {
 
 template <class T, int N>
 struct Pack {
+    static constexpr bool split = false;
     using Native = stdx::simd<T, stdx::simd_abi::deduce_t<T, N>>;
     static_assert(Native::size() == std::size_t(N));
     Native native;
@@ -84,6 +86,60 @@ struct Pack {
     PRISM_SIMD_INLINE friend Pack select(Mask<T, N> mask, Pack a, Pack b) {
         stdx::where(mask.native, b.native) = a.native;
         return b;
+    }
+};
+
+// More lanes than one register of the target holds (16 floats or 8 doubles under AVX2): two
+// halves, each a Pack of one register, and every operation done on both. libstdc++ gives such
+// a width its fixed_size ABI instead, whose masks are bitsets: every compare converted the
+// lanes to bits and every select back, and on an AVX2 machine (the AMD EPYC VM, 2026-12-01) the
+// dragon's rays in double, whose wide BVH tests 8 children in 8 doubles, took 3.2-4.1 times
+// float's time per ray (bench/RESULTS.md, "Per ray against Embree"). The same IEEE operation
+// per lane either way, so the same bits.
+template <class T, int N>
+inline constexpr bool needs_halves =
+    N % 2 == 0 && std::is_same_v<stdx::simd_abi::deduce_t<T, N>, stdx::simd_abi::fixed_size<N>>;
+
+template <class T, int N>
+    requires needs_halves<T, N>
+struct Mask<T, N> {
+    static constexpr bool split = true;
+    Mask<T, N / 2> low, high;  // lanes [0, N/2) and [N/2, N)
+
+    PRISM_SIMD_INLINE friend Mask operator&(Mask a, Mask b) { return {a.low & b.low, a.high & b.high}; }
+    PRISM_SIMD_INLINE friend Mask operator|(Mask a, Mask b) { return {a.low | b.low, a.high | b.high}; }
+    PRISM_SIMD_INLINE friend Mask operator!(Mask a) { return {!a.low, !a.high}; }
+    PRISM_SIMD_INLINE bool any() const { return (low | high).any(); }
+    PRISM_SIMD_INLINE std::uint32_t bits() const { return low.bits() | high.bits() << (N / 2); }
+};
+
+template <class T, int N>
+    requires needs_halves<T, N>
+struct Pack<T, N> {
+    static constexpr bool split = true;
+    using Half = Pack<T, N / 2>;
+    Half low, high;  // lanes [0, N/2) and [N/2, N)
+
+    PRISM_SIMD_INLINE static Pack broadcast(T value) { return {Half::broadcast(value), Half::broadcast(value)}; }
+    PRISM_SIMD_INLINE static Pack load(const T* values) { return {Half::load(values), Half::load(values + N / 2)}; }
+    PRISM_SIMD_INLINE void store(T* values) const {
+        low.store(values);
+        high.store(values + N / 2);
+    }
+
+    PRISM_SIMD_INLINE friend Pack operator+(Pack a, Pack b) { return {a.low + b.low, a.high + b.high}; }
+    PRISM_SIMD_INLINE friend Pack operator-(Pack a, Pack b) { return {a.low - b.low, a.high - b.high}; }
+    PRISM_SIMD_INLINE friend Pack operator*(Pack a, Pack b) { return {a.low * b.low, a.high * b.high}; }
+    PRISM_SIMD_INLINE friend Pack operator/(Pack a, Pack b) { return {a.low / b.low, a.high / b.high}; }
+    PRISM_SIMD_INLINE friend Pack operator-(Pack a) { return {-a.low, -a.high}; }
+    PRISM_SIMD_INLINE friend Mask<T, N> operator<(Pack a, Pack b) { return {a.low < b.low, a.high < b.high}; }
+    PRISM_SIMD_INLINE friend Mask<T, N> operator<=(Pack a, Pack b) { return {a.low <= b.low, a.high <= b.high}; }
+    PRISM_SIMD_INLINE friend Mask<T, N> operator>(Pack a, Pack b) { return {a.low > b.low, a.high > b.high}; }
+    PRISM_SIMD_INLINE friend Mask<T, N> operator>=(Pack a, Pack b) { return {a.low >= b.low, a.high >= b.high}; }
+    PRISM_SIMD_INLINE friend Mask<T, N> operator==(Pack a, Pack b) { return {a.low == b.low, a.high == b.high}; }
+    PRISM_SIMD_INLINE friend Mask<T, N> operator!=(Pack a, Pack b) { return {a.low != b.low, a.high != b.high}; }
+    PRISM_SIMD_INLINE friend Pack select(Mask<T, N> mask, Pack a, Pack b) {
+        return {select(mask.low, a.low, b.low), select(mask.high, a.high, b.high)};
     }
 };
 
@@ -169,6 +225,7 @@ private:
 
 template <class T, int N>
 struct Pack {
+    static constexpr bool split = false;
     std::array<T, N> lanes;
 
     PRISM_SIMD_INLINE static Pack broadcast(T value) {
@@ -228,19 +285,19 @@ private:
 // its own instruction is used; elsewhere the select.
 template <class T, int N>
 PRISM_SIMD_INLINE inline Pack<T, N> max_keep(Pack<T, N> a, Pack<T, N> b) {
+    if constexpr (Pack<T, N>::split) return {max_keep(a.low, b.low), max_keep(a.high, b.high)};
 #if defined(PRISM_SIMD_STDX) && defined(PRISM_SIMD_X86)
-    if constexpr (x86::has_min_max<T, typename Pack<T, N>::Native>) return {x86::min_max<true, T>(a.native, b.native)};
-    else
+    else if constexpr (x86::has_min_max<T, typename Pack<T, N>::Native>) return {x86::min_max<true, T>(a.native, b.native)};
 #endif
-        return select(a > b, a, b);
+    else return select(a > b, a, b);
 }
 template <class T, int N>
 PRISM_SIMD_INLINE inline Pack<T, N> min_keep(Pack<T, N> a, Pack<T, N> b) {
+    if constexpr (Pack<T, N>::split) return {min_keep(a.low, b.low), min_keep(a.high, b.high)};
 #if defined(PRISM_SIMD_STDX) && defined(PRISM_SIMD_X86)
-    if constexpr (x86::has_min_max<T, typename Pack<T, N>::Native>) return {x86::min_max<false, T>(a.native, b.native)};
-    else
+    else if constexpr (x86::has_min_max<T, typename Pack<T, N>::Native>) return {x86::min_max<false, T>(a.native, b.native)};
 #endif
-        return select(a < b, a, b);
+    else return select(a < b, a, b);
 }
 
 // The correctly rounded square root, lane by lane: std::sqrt's bits. The 512-bit forms through
@@ -248,17 +305,21 @@ PRISM_SIMD_INLINE inline Pack<T, N> min_keep(Pack<T, N> a, Pack<T, N> b) {
 template <class T, int N>
 PRISM_SIMD_INLINE inline Pack<T, N> sqrt(Pack<T, N> a) {
 #if defined(PRISM_SIMD_STDX)
+    if constexpr (Pack<T, N>::split) {
+        return {sqrt(a.low), sqrt(a.high)};
+    } else {
 #if defined(PRISM_SIMD_X86) && defined(__AVX512F__)
-    using Native = typename Pack<T, N>::Native;
-    if constexpr (std::is_same_v<T, float> && requires(const Native& v) { static_cast<__m512>(v); }) {
-        const __m512 x = static_cast<__m512>(a.native);
-        return {Native(_mm512_mask_sqrt_ps(x, __mmask16(-1), x))};
-    } else if constexpr (std::is_same_v<T, double> && requires(const Native& v) { static_cast<__m512d>(v); }) {
-        const __m512d x = static_cast<__m512d>(a.native);
-        return {Native(_mm512_mask_sqrt_pd(x, __mmask8(-1), x))};
-    } else
+        using Native = typename Pack<T, N>::Native;
+        if constexpr (std::is_same_v<T, float> && requires(const Native& v) { static_cast<__m512>(v); }) {
+            const __m512 x = static_cast<__m512>(a.native);
+            return {Native(_mm512_mask_sqrt_ps(x, __mmask16(-1), x))};
+        } else if constexpr (std::is_same_v<T, double> && requires(const Native& v) { static_cast<__m512d>(v); }) {
+            const __m512d x = static_cast<__m512d>(a.native);
+            return {Native(_mm512_mask_sqrt_pd(x, __mmask8(-1), x))};
+        } else
 #endif
-        return {stdx::sqrt(a.native)};
+            return {stdx::sqrt(a.native)};
+    }
 #else
     for (T& lane : a.lanes) lane = std::sqrt(lane);
     return a;
@@ -276,28 +337,30 @@ PRISM_SIMD_INLINE inline Pack<T, N> sqrt(Pack<T, N> a) {
 template <class T, int N>
 PRISM_SIMD_INLINE inline void load_transposed(const T* const* rows, Pack<T, N>* columns) {
 #if defined(PRISM_SIMD_STDX) && defined(PRISM_SIMD_X86) && defined(__AVX__)
-    using Native = typename Pack<T, N>::Native;
-    if constexpr (std::is_same_v<T, float> && N == 8 && requires(const Native& v) { static_cast<__m256>(v); }) {
-        __m256 r[8];
-        for (int i = 0; i < 8; ++i) r[i] = _mm256_loadu_ps(rows[i]);
-        // Pairs of rows interleaved, then quadruples, then the 128-bit halves exchanged.
-        const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
-        const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
-        const __m256 t4 = _mm256_unpacklo_ps(r[4], r[5]), t5 = _mm256_unpackhi_ps(r[4], r[5]);
-        const __m256 t6 = _mm256_unpacklo_ps(r[6], r[7]), t7 = _mm256_unpackhi_ps(r[6], r[7]);
-        const __m256 u0 = _mm256_shuffle_ps(t0, t2, 0x44), u1 = _mm256_shuffle_ps(t0, t2, 0xee);
-        const __m256 u2 = _mm256_shuffle_ps(t1, t3, 0x44), u3 = _mm256_shuffle_ps(t1, t3, 0xee);
-        const __m256 u4 = _mm256_shuffle_ps(t4, t6, 0x44), u5 = _mm256_shuffle_ps(t4, t6, 0xee);
-        const __m256 u6 = _mm256_shuffle_ps(t5, t7, 0x44), u7 = _mm256_shuffle_ps(t5, t7, 0xee);
-        columns[0] = {Native(_mm256_permute2f128_ps(u0, u4, 0x20))};
-        columns[1] = {Native(_mm256_permute2f128_ps(u1, u5, 0x20))};
-        columns[2] = {Native(_mm256_permute2f128_ps(u2, u6, 0x20))};
-        columns[3] = {Native(_mm256_permute2f128_ps(u3, u7, 0x20))};
-        columns[4] = {Native(_mm256_permute2f128_ps(u0, u4, 0x31))};
-        columns[5] = {Native(_mm256_permute2f128_ps(u1, u5, 0x31))};
-        columns[6] = {Native(_mm256_permute2f128_ps(u2, u6, 0x31))};
-        columns[7] = {Native(_mm256_permute2f128_ps(u3, u7, 0x31))};
-        return;
+    if constexpr (std::is_same_v<T, float> && N == 8 && !Pack<T, N>::split) {
+        using Native = typename Pack<T, N>::Native;
+        if constexpr (requires(const Native& v) { static_cast<__m256>(v); }) {
+            __m256 r[8];
+            for (int i = 0; i < 8; ++i) r[i] = _mm256_loadu_ps(rows[i]);
+            // Pairs of rows interleaved, then quadruples, then the 128-bit halves exchanged.
+            const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
+            const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
+            const __m256 t4 = _mm256_unpacklo_ps(r[4], r[5]), t5 = _mm256_unpackhi_ps(r[4], r[5]);
+            const __m256 t6 = _mm256_unpacklo_ps(r[6], r[7]), t7 = _mm256_unpackhi_ps(r[6], r[7]);
+            const __m256 u0 = _mm256_shuffle_ps(t0, t2, 0x44), u1 = _mm256_shuffle_ps(t0, t2, 0xee);
+            const __m256 u2 = _mm256_shuffle_ps(t1, t3, 0x44), u3 = _mm256_shuffle_ps(t1, t3, 0xee);
+            const __m256 u4 = _mm256_shuffle_ps(t4, t6, 0x44), u5 = _mm256_shuffle_ps(t4, t6, 0xee);
+            const __m256 u6 = _mm256_shuffle_ps(t5, t7, 0x44), u7 = _mm256_shuffle_ps(t5, t7, 0xee);
+            columns[0] = {Native(_mm256_permute2f128_ps(u0, u4, 0x20))};
+            columns[1] = {Native(_mm256_permute2f128_ps(u1, u5, 0x20))};
+            columns[2] = {Native(_mm256_permute2f128_ps(u2, u6, 0x20))};
+            columns[3] = {Native(_mm256_permute2f128_ps(u3, u7, 0x20))};
+            columns[4] = {Native(_mm256_permute2f128_ps(u0, u4, 0x31))};
+            columns[5] = {Native(_mm256_permute2f128_ps(u1, u5, 0x31))};
+            columns[6] = {Native(_mm256_permute2f128_ps(u2, u6, 0x31))};
+            columns[7] = {Native(_mm256_permute2f128_ps(u3, u7, 0x31))};
+            return;
+        }
     }
 #endif
     alignas(64) T lanes[N][N];
