@@ -284,9 +284,13 @@ private:
         const TraversalRay traversal_ray(ray);
         std::optional<TriangleRay> world_triangle_ray;  // made when the ray first enters a mesh
         // The merged world-space meshes first: their hit lowers t_max before the top level
-        // tests any box.
+        // tests any box. An index is entered without enters()'s pre-test, which repeats the
+        // root's node test that traversal then makes (the same test, so the same hits): the
+        // triangle set-up is made for nothing only for a ray that misses the root, and the
+        // course's closest hits rarely do (the course mesh's primary rays: 0.92 of the time
+        // with it, bench/RESULTS.md). Shadow rays keep it (occluded_indexed): many leave the
+        // scene without a mesh.
         bool found = false;
-        std::optional<RayBoxPrecomputed<Real>> box_ray;  // made once, for the first group's box
         for (const WorldMeshes& group : world_meshes_) {
             const Mesh& index = index_of(group);
             bool group_hit = false;
@@ -295,7 +299,6 @@ private:
                     group_hit = intersect_root_leaves<true>(index, *group.leaves, ray, world_triangle_ray, hit, cull);
                 }
             } else {
-                if (!enters(index, ray, traversal_ray, box_ray)) continue;
                 if (!world_triangle_ray) world_triangle_ray.emplace(ray);
                 group_hit = index.intersect(ray, traversal_ray, *world_triangle_ray, ray.t_max, hit, cull);
             }
@@ -429,9 +432,9 @@ private:
     }
 
     // Whether the ray meets the box of a world-space index within its interval, by the same
-    // conservative slab test as the BVHs (Ize's widened exit): the triangle set-up is then made
-    // before the index is entered (eagerly, outside the kernel's leaf loop) and only for rays
-    // that may reach a leaf, as the top level's box test did for a mesh in it.
+    // conservative slab test as the BVHs (Ize's widened exit): a shadow ray's triangle set-up is
+    // then made before the index is entered (eagerly, outside the kernel's leaf loop) and only
+    // if it may reach a leaf, as the top level's box test did for a mesh in it.
     // A wide BVH tests its root's children with the traversal ray instead (WideBvhTree::enters):
     // no division of its own, and rays between the children's boxes are stopped too.
     static bool enters(const Mesh& index, const Ray<Real>& ray, const TraversalRay& traversal_ray,
