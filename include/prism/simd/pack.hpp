@@ -68,7 +68,22 @@ struct Pack {
     Native native;
 
     PRISM_SIMD_INLINE static Pack broadcast(T value) { return {Native(value)}; }
-    PRISM_SIMD_INLINE static Pack load(const T* values) { return {Native(values, stdx::element_aligned)}; }
+    // An AVX register's load through its intrinsic: libstdc++'s load (a memcpy into the
+    // vector) left GCC 12 storing some loaded packs to the stack and reading them back at once,
+    // in the wide BVH's node test on the third axis's planes (a store-to-load forward on the
+    // chain from a node's address to the next), 16 such pairs in the intersection benchmark and
+    // 4 in `prism`. Without them, AVX2 float rays on the course mesh took about 0.83 of the
+    // time (bench/RESULTS.md, "Per ray against Embree"); the same loaded bits.
+    PRISM_SIMD_INLINE static Pack load(const T* values) {
+#if defined(PRISM_SIMD_X86) && defined(__AVX__)
+        if constexpr (std::is_same_v<T, float> && requires(const Native& v) { static_cast<__m256>(v); })
+            return {Native(_mm256_loadu_ps(values))};
+        else if constexpr (std::is_same_v<T, double> && requires(const Native& v) { static_cast<__m256d>(v); })
+            return {Native(_mm256_loadu_pd(values))};
+        else
+#endif
+            return {Native(values, stdx::element_aligned)};
+    }
     PRISM_SIMD_INLINE void store(T* values) const { native.copy_to(values, stdx::element_aligned); }
 
     PRISM_SIMD_INLINE friend Pack operator+(Pack a, Pack b) { return {a.native + b.native}; }
