@@ -130,6 +130,48 @@ TEST_CASE_TEMPLATE("lat-long mapping: the course's axes and round trips", Real, 
     CHECK(prism::latlong_coordinates(Vec3<Real>(0, 0, 1)).y == doctest::Approx(0.5));
 }
 
+TEST_CASE_TEMPLATE("lookup: bilinear between pixel centres, lat-long columns wrap, rows and probes clamp", Real, float,
+                   double) {
+    // A 4x2 map whose pixel (x, y) holds x + 10 y: a blend of columns shows where u landed.
+    prism::Image image(4, 2);
+    for (int y = 0; y < 2; ++y)
+        for (int x = 0; x < 4; ++x) image(x, y) = glm::vec3(float(x + 10 * y));
+    const auto shared = std::make_shared<const prism::Image>(image);
+    const prism::EnvironmentMap<Real> latlong(shared, Layout::latlong), probe(shared, Layout::probe);
+    const auto at = [](const prism::EnvironmentMap<Real>& map, double u, double v) {
+        return double(map.lookup(Vec2<Real>(Real(u), Real(v))).x);
+    };
+    // Pixel centres: u = (x + 0.5) / 4, v = (y + 0.5) / 2.
+    CHECK(at(latlong, 0.375, 0.25) == doctest::Approx(1));
+    CHECK(at(latlong, 0.5, 0.25) == doctest::Approx(1.5));
+    // Left of the first centre, a lat-long map blends the last column with the first (one
+    // meridian); a probe clamps to its first column.
+    CHECK(at(latlong, 0.0, 0.25) == doctest::Approx(1.5));     // (3 + 0) / 2
+    CHECK(at(latlong, 0.0625, 0.25) == doctest::Approx(0.75)); // 3 / 4 + 0
+    CHECK(at(probe, 0.0, 0.25) == doctest::Approx(0));
+    // Right of the last centre the same way round, and u past 1 goes on around.
+    CHECK(at(latlong, 1.0, 0.25) == doctest::Approx(1.5));
+    CHECK(at(latlong, 1.125, 0.25) == doctest::Approx(at(latlong, 0.125, 0.25)));
+    CHECK(at(latlong, -0.875, 0.75) == doctest::Approx(at(latlong, 0.125, 0.75)));
+    CHECK(at(probe, 1.0, 0.25) == doctest::Approx(3));
+    // Rows clamp in both layouts: above the first centre is the first row.
+    CHECK(at(latlong, 0.375, 0.0) == doctest::Approx(1));
+    CHECK(at(latlong, 0.375, 1.0) == doctest::Approx(11));
+    CHECK(at(probe, 0.375, 0.5) == doctest::Approx(6));
+}
+
+TEST_CASE("repeat_index and repeat_next: the remainder's wrap, with or without the division") {
+    for (const int size : {1, 2, 3, 7, 512}) {
+        for (int index = -3 * size - 2; index <= 3 * size + 2; ++index) {
+            const int expected = ((index % size) + size) % size;
+            CHECK(prism::repeat_index(index, size) == expected);
+            if (index >= 0 && index < size) CHECK(prism::repeat_next(index, size) == ((index + 1) % size));
+        }
+    }
+    CHECK(prism::repeat_index(std::numeric_limits<int>::min(), 7) == ((std::numeric_limits<int>::min() % 7) + 7) % 7);
+    CHECK(prism::repeat_index(std::numeric_limits<int>::max(), 7) == std::numeric_limits<int>::max() % 7);
+}
+
 TEST_CASE_TEMPLATE("probe mapping: the course's axes and round trips", Real, float, double) {
     // Centre -Z, right +X, up +Y; radius proportional to the angle from -Z, so the axes at 90
     // degrees sit halfway to the rim.

@@ -42,6 +42,18 @@ struct Image {
     }
 };
 
+// Repeat addressing (a texture's or a lat-long map's wrap): `index` wrapped into [0, size), by
+// the remainder's one integer division. No branch around the division for an index already
+// inside: with (u, v) beyond [0, 1) half the time (tiled textures), its mispredictions took
+// nearest lookups to 1.6-2.3 times as long (prism_texture_bench).
+inline int repeat_index(int index, int size) {
+    const int wrapped = index % size;
+    return wrapped < 0 ? wrapped + size : wrapped;
+}
+// The repeated index after `index`, which is in [0, size): repeat_index(index + 1, size) without
+// a second division (a bilinear lookup's other column and row).
+inline int repeat_next(int index, int size) { return index + 1 == size ? 0 : index + 1; }
+
 // Pixels per run of the passes over an image that run on TBB's threads (decode_image's
 // conversion): 3 MB of film, about a huge page and a half, so that two threads seldom fault in
 // the same page.

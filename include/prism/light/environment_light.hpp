@@ -144,7 +144,7 @@ private:
                 for (int dy = -1; dy <= 1; ++dy)
                     for (int dx = -1; dx <= 1; ++dx) {
                         const int row = std::clamp(y + dy, 0, height - 1);
-                        const int column = latlong ? (x + dx + width) % width : std::clamp(x + dx, 0, width - 1);
+                        const int column = latlong ? repeat_index(x + dx, width) : std::clamp(x + dx, 0, width - 1);
                         brightest = std::max(brightest, pixel_luminance[std::size_t(row) * std::size_t(width) + std::size_t(column)]);
                     }
                 Real solid_angle = 0;

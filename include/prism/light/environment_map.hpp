@@ -119,15 +119,18 @@ public:
         const Real x_floor = std::floor(x), y_floor = std::floor(y);
         const Real fx = x - x_floor, fy = y - y_floor;
         const int x0 = int(x_floor), y0 = int(y_floor);
-        const bool wraps = layout_ == scene::EnvironmentLayout::latlong;
-        auto column = [&](int c) {
-            if (wraps) return ((c % image.width) + image.width) % image.width;
-            return std::clamp(c, 0, image.width - 1);
-        };
-        auto row = [&](int r) { return std::clamp(r, 0, image.height - 1); };
-        auto texel = [&](int c, int r) { return Vec3<Real>(image(column(c), row(r))); };
-        return (1 - fy) * ((1 - fx) * texel(x0, y0) + fx * texel(x0 + 1, y0)) +
-               fy * ((1 - fx) * texel(x0, y0 + 1) + fx * texel(x0 + 1, y0 + 1));
+        int c0, c1;
+        if (layout_ == scene::EnvironmentLayout::latlong) {
+            c0 = repeat_index(x0, image.width);
+            c1 = repeat_next(c0, image.width);
+        } else {
+            c0 = std::clamp(x0, 0, image.width - 1);
+            c1 = std::clamp(x0 + 1, 0, image.width - 1);
+        }
+        const int r0 = std::clamp(y0, 0, image.height - 1), r1 = std::clamp(y0 + 1, 0, image.height - 1);
+        auto texel = [&](int c, int r) { return Vec3<Real>(image(c, r)); };
+        return (1 - fy) * ((1 - fx) * texel(c0, r0) + fx * texel(c1, r0)) +
+               fy * ((1 - fx) * texel(c0, r1) + fx * texel(c1, r1));
     }
 
     // The scaled radiance arriving from `direction` (unit): what a ray that escapes the scene

@@ -131,8 +131,8 @@ private:
 
     template <class Texels2D>
     static Vec3<Real> nearest_in(const Texels2D& image, const Vec2<Real>& uv) {
-        const int x = repeat(int(std::floor(uv.x * Real(image.width))), image.width);
-        const int y = repeat(int(std::floor(uv.y * Real(image.height))), image.height);
+        const int x = repeat_index(int(std::floor(uv.x * Real(image.width))), image.width);
+        const int y = repeat_index(int(std::floor(uv.y * Real(image.height))), image.height);
         return Vec3<Real>(image(x, y));
     }
 
@@ -142,16 +142,11 @@ private:
         const Real y = uv.y * Real(image.height);
         const Real x_floor = std::floor(x), y_floor = std::floor(y);
         const Real fx = x - x_floor, fy = y - y_floor;
-        const int x0 = repeat(int(x_floor), image.width), x1 = repeat(x0 + 1, image.width);
-        const int y0 = repeat(int(y_floor), image.height), y1 = repeat(y0 + 1, image.height);
+        const int x0 = repeat_index(int(x_floor), image.width), x1 = repeat_next(x0, image.width);
+        const int y0 = repeat_index(int(y_floor), image.height), y1 = repeat_next(y0, image.height);
         const Vec3<Real> top = (1 - fx) * Vec3<Real>(image(x0, y0)) + fx * Vec3<Real>(image(x1, y0));
         const Vec3<Real> bottom = (1 - fx) * Vec3<Real>(image(x0, y1)) + fx * Vec3<Real>(image(x1, y1));
         return (1 - fy) * top + fy * bottom;
-    }
-
-    static int repeat(int index, int size) {
-        const int wrapped = index % size;
-        return wrapped < 0 ? wrapped + size : wrapped;
     }
 
     std::shared_ptr<const Texels> base_;
