@@ -84,7 +84,18 @@ public:
     // The closest plane in (ray.t_min, ray.t_max] (ray.t_max lowered to it, hit filled): the
     // lanes are accepted in order as one plane after another would be, so the hit is the
     // scalar loop's. cull_back_faces (culls_planes): planes met from behind are skipped.
-    bool closest(Ray<Real>& ray, Hit<Real>& hit, bool cull_back_faces) const {
+    // The test for no planes is inlined into the caller (the index's entries ask every ray):
+    // most scenes have none, and the call into an empty loop was 0.8% of the dragon's
+    // closest-hit profile.
+    PRISM_FORCE_INLINE bool closest(Ray<Real>& ray, Hit<Real>& hit, bool cull_back_faces) const {
+        return !blocks_.empty() && closest_in_blocks(ray, hit, cull_back_faces);
+    }
+
+    // Whether a plane lies in (ray.t_min, ray.t_max).
+    PRISM_FORCE_INLINE bool occludes(const Ray<Real>& ray) const { return !blocks_.empty() && occludes_in_blocks(ray); }
+
+private:
+    bool closest_in_blocks(Ray<Real>& ray, Hit<Real>& hit, bool cull_back_faces) const {
         bool found = false;
         for (std::size_t b = 0; b < blocks_.size(); ++b) {
             alignas(64) Real t[width];
@@ -101,8 +112,7 @@ public:
         return found;
     }
 
-    // Whether a plane lies in (ray.t_min, ray.t_max).
-    bool occludes(const Ray<Real>& ray) const {
+    bool occludes_in_blocks(const Ray<Real>& ray) const {
         for (const Block& block : blocks_) {
             alignas(64) Real t[width];
             alignas(64) Real denominator[width];
@@ -112,7 +122,6 @@ public:
         return false;
     }
 
-private:
     using Lanes = simd::Pack<Real, width>;
     struct Block {
         alignas(64) Real point[3][width] = {};
