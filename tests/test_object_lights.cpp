@@ -113,6 +113,55 @@ TEST_CASE_TEMPLATE("SphericalTriangle: its solid angle, and directions uniform i
     }
 }
 
+TEST_CASE_TEMPLATE("SphericalTriangle::unsamplable_beyond: past it no view is samplable, and it is not far past",
+                   Real, float, double) {
+    using prism::SphericalTriangle;
+    using V = prism::Vec3<Real>;
+    prism::Random random(11);
+    const auto unit = [&] {
+        // A direction uniform on the sphere.
+        const double z = 2 * random.uniform<double>() - 1, phi = 2 * pi * random.uniform<double>();
+        const double r = std::sqrt(std::max(0.0, 1 - z * z));
+        return glm::dvec3(r * std::cos(phi), r * std::sin(phi), z);
+    };
+    int checked = 0;
+    for (int shape = 0; shape < 400; ++shape) {
+        // Triangles from a hundredth to ten units across, slivers among them, far from the origin
+        // for some, as LightMesh keeps them: a vertex, two edges, and the centroid, each rounded.
+        const double size = std::pow(10.0, 3 * random.uniform<double>() - 2);
+        const glm::dvec3 base = (shape % 4 == 0 ? 100.0 : 1.0) * unit();
+        const glm::dvec3 e1 = size * unit(), e2 = size * (shape % 3 == 0 ? 1e-3 : 1.0) * unit();
+        const V a(base), edge1(e1), edge2(e2), centroid(base + (e1 + e2) / 3.0);
+        const Real bound = SphericalTriangle::unsamplable_beyond(a, edge1, edge2, centroid);
+        REQUIRE(bound > 0);
+        REQUIRE(std::isfinite(bound));
+        for (int view = 0; view < 50; ++view) {
+            // Just past the bound (by up to a thousandth), and along the normal on every tenth view.
+            const glm::dvec3 normal = glm::normalize(glm::cross(e1, e2));
+            const glm::dvec3 towards = view % 10 == 0 ? normal : unit();
+            const double distance = std::sqrt(double(bound)) * (1 + 1e-3 * random.uniform<double>());
+            const V viewpoint(glm::dvec3(centroid) + distance * towards);
+            // The comparison LightMesh makes, in Real.
+            const V to_centroid = centroid - viewpoint;
+            if (!(glm::dot(to_centroid, to_centroid) > bound)) continue;
+            ++checked;
+            const SphericalTriangle seen(viewpoint, a, edge1, edge2);
+            CHECK_FALSE(seen.samplable());
+        }
+    }
+    CHECK(checked > 15000);
+    // Seen broadside from the bound, an equilateral triangle still subtends more than half the
+    // smallest samplable solid angle: the bound is not so loose that it skips nothing.
+    const double side = 0.5;
+    const glm::dvec3 p0(0, 0, 0), p1(side, 0, 0), p2(side / 2, side * std::sqrt(3.0) / 2, 0);
+    const V centroid((p0 + p1 + p2) / 3.0);
+    const Real bound = SphericalTriangle::unsamplable_beyond(V(p0), V(p1 - p0), V(p2 - p0), centroid);
+    const glm::dvec3 broadside = glm::dvec3(centroid) + glm::dvec3(0, 0, std::sqrt(double(bound)));
+    const double omega = SphericalTriangle(broadside, p0, p1 - p0, p2 - p0).solid_angle();
+    CHECK(omega > 0.5 * SphericalTriangle::smallest_solid_angle);
+    CHECK(omega < SphericalTriangle::smallest_solid_angle);
+}
+
 // How large a triangle looks from `from` (LightMesh's weight, written out again in double):
 // A |cos| / d^3 at its centroid, at most 2 pi.
 double looks(const glm::dvec3& from, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {

@@ -46,6 +46,17 @@ struct LightMesh {
         Vec3<Real> a{0}, edge1{0}, edge2{0};
         Vec3<Real> normal{0, 0, 1};  // unit
         Real area = 0;
+        // Beyond this squared distance from the centroid the triangle looks too small to sample
+        // by solid angle (SphericalTriangle::unsamplable_beyond): most shading points of the
+        // hw7 Cornell boxes see their light box so, and need no spherical triangle in double.
+        Vec3<Real> centroid{0};
+        Real unsamplable_beyond = 0;
+
+        // Whether SphericalTriangle(viewpoint, a, edge1, edge2).samplable() may be true.
+        bool may_be_samplable(const Vec3<Real>& viewpoint) const {
+            const Vec3<Real> to_centroid = centroid - viewpoint;
+            return !(glm::dot(to_centroid, to_centroid) > unsamplable_beyond);
+        }
     };
     std::vector<Triangle> triangles;  // world space
     PiecewiseConstant1D<Real> by_area;
@@ -67,8 +78,11 @@ struct LightMesh {
             const glm::dvec3 a = world(triangle[0]), b = world(triangle[1]), c = world(triangle[2]);
             const glm::dvec3 cross = glm::cross(b - a, c - a);
             const double length = glm::length(cross);
-            light.triangles.push_back({Vec3<Real>(a), Vec3<Real>(b - a), Vec3<Real>(c - a),
-                                       Vec3<Real>(length > 0 ? cross / length : glm::dvec3(0, 0, 1)), Real(length / 2)});
+            Triangle made{Vec3<Real>(a), Vec3<Real>(b - a), Vec3<Real>(c - a),
+                          Vec3<Real>(length > 0 ? cross / length : glm::dvec3(0, 0, 1)), Real(length / 2)};
+            made.centroid = Vec3<Real>((a + b + c) / 3.0);
+            made.unsamplable_beyond = SphericalTriangle::unsamplable_beyond(made.a, made.edge1, made.edge2, made.centroid);
+            light.triangles.push_back(made);
             if (light.triangles.size() <= weighed_by_view) light.view.add(light.triangles.size() - 1, a, b, c, cross / 2.0);
             areas.push_back(Real(length / 2));
             total += length / 2;
@@ -106,8 +120,10 @@ struct LightMesh {
         const Real chance = chance_of(from, triangle);
         if (!(chance > 0)) return 0;
         const Triangle& t = triangles[triangle];
-        const SphericalTriangle view(from.position, t.a, t.edge1, t.edge2);
-        if (view.samplable()) return Real(double(chance) / view.solid_angle());
+        if (t.may_be_samplable(from.position)) {
+            const SphericalTriangle view(from.position, t.a, t.edge1, t.edge2);
+            if (view.samplable()) return Real(double(chance) / view.solid_angle());
+        }
         const Vec3<Real> to_light = point - from.position;
         const Real distance_squared = glm::dot(to_light, to_light);
         const Real cos_light = std::abs(glm::dot(normal, to_light)) / std::sqrt(distance_squared);
@@ -119,14 +135,17 @@ struct LightMesh {
         const Choice choice = choose(at, u.x);
         if (!(choice.chance > 0)) return {at.normal, Real(0), Vec3<Real>(0), Real(0)};
         const Triangle& triangle = triangles[choice.triangle];
-        const SphericalTriangle view(at.position, triangle.a, triangle.edge1, triangle.edge2);
-        if (view.samplable()) {
-            const Vec3<Real> direction = view.sample(Vec2<Real>(choice.reused, u.y));
-            // Where the direction meets the triangle's plane.
-            const Real distance = glm::dot(triangle.normal, triangle.a - at.position) / glm::dot(triangle.normal, direction);
-            if (!(distance > 0) || !std::isfinite(distance)) return {direction, Real(0), Vec3<Real>(0), Real(0)};
-            const Real density = Real(double(choice.chance) / view.solid_angle());
-            return {direction, distance, radiance / density, density};
+        if (triangle.may_be_samplable(at.position)) {
+            const SphericalTriangle view(at.position, triangle.a, triangle.edge1, triangle.edge2);
+            if (view.samplable()) {
+                const Vec3<Real> direction = view.sample(Vec2<Real>(choice.reused, u.y));
+                // Where the direction meets the triangle's plane.
+                const Real distance =
+                    glm::dot(triangle.normal, triangle.a - at.position) / glm::dot(triangle.normal, direction);
+                if (!(distance > 0) || !std::isfinite(distance)) return {direction, Real(0), Vec3<Real>(0), Real(0)};
+                const Real density = Real(double(choice.chance) / view.solid_angle());
+                return {direction, distance, radiance / density, density};
+            }
         }
         const Real root = std::sqrt(choice.reused);
         const Vec3<Real> point = triangle.a + root * (1 - u.y) * triangle.edge1 + root * u.y * triangle.edge2;

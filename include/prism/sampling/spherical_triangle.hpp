@@ -20,10 +20,12 @@
 // samples for its 0.2544 of the solid angle, 6 standard deviations); in double it received 0.2548.
 #pragma once
 
+#include <prism/math/floating_point.hpp>
 #include <prism/math/vector.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace prism {
 
@@ -45,6 +47,29 @@ public:
     SphericalTriangle(const Vec3<Input>& viewpoint, const Vec3<Input>& v0, const Vec3<Input>& edge1,
                       const Vec3<Input>& edge2)
         : SphericalTriangle(Vec3<Real>(v0) - Vec3<Real>(viewpoint), Vec3<Real>(edge1), Vec3<Real>(edge2)) {}
+
+    // The squared distance from `centre` (any point near the triangle: LightMesh gives its
+    // centroid) beyond which the triangle with vertex `v0` and edges `edge1`, `edge2` is
+    // certainly not samplable(): from a viewpoint p with |p - centre| > R + sqrt(A / Omega_min)
+    // (R the farthest vertex from the centre, A the area), every point of the triangle is at
+    // least d = |p - centre| - R away, and the solid angle, the integral of cos / r^2 over the
+    // triangle, is at most A / d^2 < Omega_min. Callers compare |p - centre|^2, computed in
+    // their own precision, and skip the constructor's three square roots in double: the
+    // answer is the one samplable() would give, since the bound is taken for 0.999 Omega_min
+    // (far beyond the rounding of samplable()'s own double arithmetic) and widened by 1e-4
+    // (far beyond the rounding of a float squared distance). Infinite where that is not
+    // representable: such a triangle is never skipped.
+    template <Scalar Input>
+    static Input unsamplable_beyond(const Vec3<Input>& v0, const Vec3<Input>& edge1, const Vec3<Input>& edge2,
+                                    const Vec3<Input>& centre) {
+        const Vec3<Real> a(v0), b = a + Vec3<Real>(edge1), c = a + Vec3<Real>(edge2), m(centre);
+        const Real reach = std::sqrt(std::max({glm::dot(a - m, a - m), glm::dot(b - m, b - m), glm::dot(c - m, c - m)}));
+        const Real area = glm::length(glm::cross(Vec3<Real>(edge1), Vec3<Real>(edge2))) / 2;
+        const Real far = reach + std::sqrt(area / (0.999 * smallest_solid_angle));
+        const Real bound = far * far * (1 + 1e-4);
+        if (!(bound < Real(std::numeric_limits<Input>::max()))) return std::numeric_limits<Input>::infinity();
+        return next_up(Input(bound));
+    }
 
     // The solid angle the triangle subtends, in steradians (0 for a degenerate view).
     Real solid_angle() const { return small_ ? angle(determinant_, denominator_) : solid_angle_; }
