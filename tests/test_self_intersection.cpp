@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <optional>
 #include <random>
@@ -524,6 +525,59 @@ TEST_CASE_TEMPLATE("InstanceTransforms: round_trip bounds a point's way to world
     }
     MESSAGE(trips, " round trips; the largest took ", double(largest_share), " of its bound");
     CHECK(largest_share > 0);
+}
+
+// The instance's offset works each pass out in 4-lane Packs (geometry/surface_error.hpp); its
+// origin must be the scalar expressions' to the bit, as the images are. The reference here is
+// that algorithm written with the scalar helpers: the object-space direction, round_trip, the
+// plain offset_ray_origin, the widening loop and transform_point. Normals include axis-aligned
+// ones (the course's plates: a zero offset on two axes) and error boxes down to zero; the
+// widening pass must be exercised too.
+TEST_CASE_TEMPLATE("instanced offset: the lanes give the scalar expressions' bits", Real, float, double) {
+    using Vec3 = prism::Vec3<Real>;
+    const auto scalar_offset = [](const prism::InstanceTransforms<Real>& instance,
+                                  const prism::PointWithError<Real>& object_point, const Vec3& normal,
+                                  const Vec3& world_direction, int& passes) {
+        const Vec3 object_direction = prism::transform_direction(instance.world_to_object, world_direction);
+        const Vec3 start = prism::abs_each(object_point.point) + object_point.error;
+        Vec3 magnitude = start;
+        Vec3 origin = object_point.point;
+        for (passes = 1; passes <= 4; ++passes) {
+            origin = prism::offset_ray_origin(object_point.point, object_point.error + instance.round_trip(magnitude),
+                                              normal, object_direction);
+            const Vec3 reached = prism::abs_each(origin);
+            if (reached.x <= magnitude.x && reached.y <= magnitude.y && reached.z <= magnitude.z) break;
+            magnitude = start + Real(2) * prism::abs_each(origin - object_point.point);
+        }
+        return prism::transform_point(instance.object_to_world, origin);
+    };
+    std::mt19937_64 rng(31);
+    long checked = 0, widened = 0;
+    for (int i = 0; i < 500; ++i) {
+        const prism::InstanceTransforms<Real> instance(random_instance_transform(rng));
+        for (int j = 0; j < 40; ++j) {
+            prism::PointWithError<Real> point;
+            for (int axis = 0; axis < 3; ++axis) {
+                point.point[axis] = Real(random_sign(rng) * log_uniform(rng, -4, 4));
+                point.error[axis] = j % 10 == 0 ? Real(0) : Real(std::abs(point.point[axis]) * log_uniform(rng, -8, -5));
+            }
+            Vec3 normal = Vec3(random_unit_vector(rng));
+            if (j % 4 == 0) {  // axis-aligned, as the plates' faces
+                normal = Vec3(0);
+                normal[j % 3] = Real(random_sign(rng));
+            }
+            const Vec3 direction = Vec3(random_unit_vector(rng));
+            int passes = 0;
+            const Vec3 expected = scalar_offset(instance, point, normal, direction, passes);
+            const Vec3 origin = prism::offset_ray_origin(instance, point, normal, direction);
+            REQUIRE(std::memcmp(&origin, &expected, sizeof(Vec3)) == 0);
+            ++checked;
+            widened += passes > 1;
+        }
+    }
+    MESSAGE(checked, " origins, ", widened, " of them after the widening pass");
+    CHECK(widened > checked / 10);
+    CHECK(widened < checked);
 }
 
 namespace {

@@ -161,6 +161,31 @@ TEST_CASE_TEMPLATE("max_keep and min_keep are a > b ? a : b and a < b ? a : b, N
     check_keep<T, 32>();
 }
 
+namespace {
+
+// generate: lane i holds lane(i), at every width (the split widths generate both halves).
+template <class T, int N>
+void check_generate() {
+    using Pack = prism::simd::Pack<T, N>;
+    const Pack p = Pack::generate([](int i) { return T(3 * i) - T(0.5); });
+    alignas(64) T out[N];
+    p.store(out);
+    for (int i = 0; i < N; ++i) {
+        CAPTURE(N);
+        CHECK(out[i] == T(3 * i) - T(0.5));
+    }
+}
+
+}  // namespace
+
+TEST_CASE_TEMPLATE("generate puts lane(i) in lane i, at every width", T, float, double) {
+    check_generate<T, 2>();
+    check_generate<T, 4>();
+    check_generate<T, 8>();
+    check_generate<T, 16>();
+    check_generate<T, 32>();
+}
+
 TEST_CASE_TEMPLATE("load_transposed: column j's lane i is row i's value j, the same bits, rows anywhere", T, float, double) {
     // Rows at scattered, unaligned places (one past an odd offset into a larger buffer), some
     // repeated, as the lanes past a batch's rays repeat its first ray; NaN and signed zeros kept.

@@ -11,8 +11,10 @@
 #include <prism/math/force_inline.hpp>
 #include <prism/math/floating_point.hpp>
 #include <prism/math/transform.hpp>
+#include <prism/simd/pack.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace prism {
@@ -179,6 +181,9 @@ struct InstanceTransforms {
     // rather than for every ray that leaves the instance.
     Mat3<Real> round_trip_linear{0};
     Vec3<Real> round_trip_constant{0};
+    // The same four columns (K's three, then k) as rows of 4 lanes, the fourth lane 0: the
+    // instance's offset below works a pass out in one register per quantity.
+    std::array<std::array<Real, 4>, 4> round_trip_lanes{};
 
     // Rounds the matrices exactly as Placement does, so A is the traversal's own matrix.
     explicit InstanceTransforms(const glm::dmat4& transform)
@@ -233,6 +238,10 @@ struct InstanceTransforms {
             round_trip_constant[row] = next_up(
                 Real((double(residual[3][row]) + c * carried + g4 * wide_abs(world_to_object[3][row])) * widen));
         }
+        for (int row = 0; row < 3; ++row) {
+            for (int column = 0; column < 3; ++column) round_trip_lanes[column][row] = round_trip_linear[column][row];
+            round_trip_lanes[3][row] = round_trip_constant[row];
+        }
     }
 
     // A bound on |A (M o) - o| per axis, as computed in Real, for every o with |o| <= magnitude.
@@ -248,10 +257,36 @@ struct InstanceTransforms {
 // The world-space origin of a ray leaving an instanced surface toward `world_direction`, given
 // the hit point in object space with its error (triangle_spawn_point or sphere_hit_point on the
 // object-space shape) and the unit object-space geometric normal.
+//
+// Each three-component quantity is one 4-lane Pack (the fourth lane unused): the direction's
+// and the final point's transforms, the round-trip bound, the error box and the offset. Every
+// lane is the scalar expression's own IEEE operations in its order (transform_direction's,
+// transform_point's, round_trip's, the plain offset_ray_origin's), so the origin has the same
+// bits as the scalar form; the dot product's sum and the one-value steps stay scalar. As
+// scalars (GCC kept them so), the two passes of a ray leaving the plates of hw3-hw4 took 235
+// instructions, 9% of metal_plates_area's (bench/RESULTS.md, "Whole renders").
 template <Scalar Real>
 Vec3<Real> offset_ray_origin(const InstanceTransforms<Real>& instance, const PointWithError<Real>& object_point,
                              const Vec3<Real>& object_normal, const Vec3<Real>& world_direction) {
-    const Vec3<Real> object_direction = transform_direction(instance.world_to_object, world_direction);
+    using Lanes = simd::Pack<Real, 4>;
+    const auto spread = [](const Vec3<Real>& v) { return Lanes::generate([&](int i) { return i < 3 ? v[i] : Real(0); }); };
+    const auto broadcast = [](Real value) { return Lanes::broadcast(value); };
+    const auto column = [](const Mat4<Real>& matrix, int k) { return Lanes::load(&matrix[k][0]); };
+    const auto bound_row = [&](int k) { return Lanes::load(instance.round_trip_lanes[std::size_t(k)].data()); };
+
+    // The side the ray leaves by, from the object-space direction (transform_direction's sums).
+    const Mat4<Real>& to_object = instance.world_to_object;
+    Real lanes[4];
+    (column(to_object, 0) * broadcast(world_direction.x) + column(to_object, 1) * broadcast(world_direction.y) +
+     column(to_object, 2) * broadcast(world_direction.z))
+        .store(lanes);
+    const Real facing = lanes[0] * object_normal.x + lanes[1] * object_normal.y + lanes[2] * object_normal.z;
+    // -(d n) and d (-n) round alike, so the sign goes on the normal once.
+    const Lanes normal = spread(facing < 0 ? -object_normal : object_normal);
+    const Lanes absolute_normal = spread(abs_each(object_normal));
+    const Lanes point = spread(object_point.point);
+    const Lanes error = spread(object_point.error);
+
     // `magnitude` bounds |o|, the object-space origin, which the round-trip bound grows with.
     // It starts at the hit point's box; if the offset carries the origin past it, it is widened
     // by twice that offset and the bound recomputed. The offset grows with |o| only by a factor
@@ -260,14 +295,32 @@ Vec3<Real> offset_ray_origin(const InstanceTransforms<Real>& instance, const Poi
     Vec3<Real> magnitude = start;
     Vec3<Real> object_origin = object_point.point;
     for (int pass = 0; pass < 4; ++pass) {
-        object_origin = offset_ray_origin(object_point.point, object_point.error + instance.round_trip(magnitude),
-                                          object_normal, object_direction);
+        // The plain offset_ray_origin with the error grown by round_trip(magnitude).
+        const Lanes round_trip = ((bound_row(0) * broadcast(magnitude.x) + bound_row(1) * broadcast(magnitude.y)) +
+                                  bound_row(2) * broadcast(magnitude.z)) +
+                                 bound_row(3);
+        (absolute_normal * (error + round_trip)).store(lanes);
+        const Real distance = lanes[0] + lanes[1] + lanes[2];
+        const Lanes offset = broadcast(distance) * normal;
+        Real steps[4];
+        offset.store(steps);
+        (point + offset).store(lanes);
+        for (int axis = 0; axis < 3; ++axis) {
+            if (steps[axis] > 0) lanes[axis] = next_up(lanes[axis]);
+            else if (steps[axis] < 0) lanes[axis] = next_down(lanes[axis]);
+            object_origin[axis] = lanes[axis];
+        }
         const Vec3<Real> reached = abs_each(object_origin);
         if (reached.x <= magnitude.x && reached.y <= magnitude.y && reached.z <= magnitude.z) break;
         magnitude = start + Real(2) * abs_each(object_origin - object_point.point);
     }
-    // Out to world space in pbrt's order, which the round-trip bound's first step assumes.
-    return transform_point(instance.object_to_world, object_origin);
+    // Out to world space in pbrt's order, which the round-trip bound's first step assumes
+    // (transform_point's sums).
+    const Mat4<Real>& to_world = instance.object_to_world;
+    ((column(to_world, 0) * broadcast(object_origin.x) + column(to_world, 1) * broadcast(object_origin.y)) +
+     (column(to_world, 2) * broadcast(object_origin.z) + column(to_world, 3)))
+        .store(lanes);
+    return {lanes[0], lanes[1], lanes[2]};
 }
 
 }  // namespace prism

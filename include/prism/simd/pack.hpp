@@ -68,6 +68,13 @@ struct Pack {
     Native native;
 
     PRISM_SIMD_INLINE static Pack broadcast(T value) { return {Native(value)}; }
+    // Lane i is lane(i): values gathered from scalars without a trip through memory (an array
+    // of them loaded made GCC 12 assemble its last two lanes in integer registers and on the
+    // stack).
+    template <class Lane>
+    PRISM_SIMD_INLINE static Pack generate(const Lane& lane) {
+        return {Native([&](auto i) { return lane(int(i)); })};
+    }
     // An AVX register's load through its intrinsic: libstdc++'s load (a memcpy into the
     // vector) left GCC 12 storing some loaded packs to the stack and reading them back at once,
     // in the wide BVH's node test on the third axis's planes (a store-to-load forward on the
@@ -136,6 +143,10 @@ struct Pack<T, N> {
     Half low, high;  // lanes [0, N/2) and [N/2, N)
 
     PRISM_SIMD_INLINE static Pack broadcast(T value) { return {Half::broadcast(value), Half::broadcast(value)}; }
+    template <class Lane>
+    PRISM_SIMD_INLINE static Pack generate(const Lane& lane) {
+        return {Half::generate(lane), Half::generate([&](int i) { return lane(i + N / 2); })};
+    }
     PRISM_SIMD_INLINE static Pack load(const T* values) { return {Half::load(values), Half::load(values + N / 2)}; }
     PRISM_SIMD_INLINE void store(T* values) const {
         low.store(values);
@@ -246,6 +257,12 @@ struct Pack {
     PRISM_SIMD_INLINE static Pack broadcast(T value) {
         Pack result;
         result.lanes.fill(value);
+        return result;
+    }
+    template <class Lane>
+    PRISM_SIMD_INLINE static Pack generate(const Lane& lane) {
+        Pack result;
+        for (int i = 0; i < N; ++i) result.lanes[i] = lane(i);
         return result;
     }
     PRISM_SIMD_INLINE static Pack load(const T* values) {
