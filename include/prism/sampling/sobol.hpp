@@ -340,16 +340,15 @@ private:
         // The pixel's digits, shuffled as every sample of the pixel shuffles them, each digit in
         // a lane (each digit's hash depends on the digits above it, not on their shuffle);
         // digits at or past bit 32 never reach a point.
+        // Only the digits that reach are hashed, one after another: a lane for each of 16
+        // digits had AVX2 emulate 64-bit multiplications for every lane, reaching or not
+        // (images of up to 2^10 pixels a side at 16 samples use 10).
         const std::uint64_t index = morton_ << log2_samples_;
-        std::array<std::uint32_t, 16> digits;
-        for (int k = 0; k < 16; ++k) {
-            const int digit = first_pixel_digit() + k, shift = digit_shift(digit);
-            const bool reaches = digit < base4_digits_ && shift < 32;
-            digits[std::size_t(k)] =
-                reaches ? permuted_digit(index, shift, permutation_above(index, shift, known.salt)) : 0;
-        }
         known.pixel_digits = 0;
-        for (const std::uint32_t digit : digits) known.pixel_digits |= digit;
+        for (int digit = first_pixel_digit(); digit < base4_digits_ && digit_shift(digit) < 32; ++digit) {
+            const int shift = digit_shift(digit);
+            known.pixel_digits |= permuted_digit(index, shift, permutation_above(index, shift, known.salt));
+        }
         const int top_digit = first_pixel_digit() - 1;
         if (top_digit >= lowest_base4_digit()) known.top = std::uint8_t(permutation_above(index, digit_shift(top_digit), known.salt));
         else if (log2_samples_ & 1) known.top = std::uint8_t(base2_flip(index, known.salt));
