@@ -1,6 +1,7 @@
 // The one SIMD layer of prism: Pack<T, N>, N lanes of float or double, and its Mask. The wide
-// BVH's node and leaf tests, the geometry's row tests (several rays side by side) and a row's
-// camera rays are written against it; every other header stays scalar.
+// BVH's node and leaf tests, the geometry's row tests (several rays side by side), a row's
+// camera rays, and three per-point computations (a light mesh's view weights, the point lights'
+// shadow lanes, an instance's ray offset) are written against it; nothing else uses intrinsics.
 // Where libstdc++'s std::experimental::simd exists (GCC 11 and later, on x86-64, ARM and
 // POWER), a Pack is a stdx::simd of the ABI that fits N lanes (one AVX register for 8 floats
 // or 4 doubles under -mavx2, two SSE or NEON registers otherwise); elsewhere, or with
