@@ -98,30 +98,22 @@ constexpr std::uint64_t morton_2d(std::uint32_t x, std::uint32_t y) {
     return spread(x) | (spread(y) << 1);
 }
 
-// The 24 permutations of {0, 1, 2, 3}, in lexicographic order, packed a byte each (two bits a
-// digit) eight to a word: the digit a permutation makes of a digit is then a shift of one of
-// three constants, which the lanes of ZSobolSampler's blocks take side by side, where a table's
-// entries are gathered one lane at a time.
-constexpr std::array<std::uint64_t, 3> base4_permutations() {
-    std::array<std::uint64_t, 3> words{};
+// The 24 permutations of {0, 1, 2, 3}, in lexicographic order, a byte each (two bits a digit):
+// the digit a permutation makes of digit d is bits 2d and 2d + 1 of its byte. ZSobolSampler's
+// blocks pack the bytes their lanes need into one word, from which each lane shifts its own.
+constexpr std::array<std::uint8_t, 24> base4_permutations() {
+    std::array<std::uint8_t, 24> bytes{};
     std::array<std::uint8_t, 4> p{0, 1, 2, 3};
     for (std::size_t permutation = 0; permutation < 24; ++permutation) {
-        for (std::size_t digit = 0; digit < 4; ++digit)
-            words[permutation / 8] |= std::uint64_t(p[digit]) << (8 * (permutation % 8) + 2 * digit);
+        for (std::size_t digit = 0; digit < 4; ++digit) bytes[permutation] |= std::uint8_t(p[digit] << (2 * digit));
         std::next_permutation(p.begin(), p.end());
     }
-    return words;
+    return bytes;
 }
-inline constexpr std::array<std::uint64_t, 3> base4_permutation_words = base4_permutations();
+inline constexpr std::array<std::uint8_t, 24> base4_permutation_bytes = base4_permutations();
 
-// Permutation `permutation` (0-23) as its byte: digit d becomes bits 2d and 2d + 1. The word is
-// chosen by comparisons, which lanes blend, rather than by an index, which they would gather.
-constexpr std::uint32_t base4_permutation_byte(std::uint32_t permutation) {
-    const std::uint64_t word = permutation < 8    ? base4_permutation_words[0]
-                               : permutation < 16 ? base4_permutation_words[1]
-                                                  : base4_permutation_words[2];
-    return std::uint32_t(word >> (8 * (permutation % 8))) & 0xff;
-}
+// Permutation `permutation` (0-23) as its byte.
+constexpr std::uint32_t base4_permutation_byte(std::uint32_t permutation) { return base4_permutation_bytes[permutation]; }
 // Digit `digit` (0-3) under permutation `permutation` (0-23).
 constexpr std::uint32_t permute_base4(std::uint32_t permutation, std::uint32_t digit) {
     return (base4_permutation_byte(permutation) >> (2 * digit)) & 3;
@@ -149,6 +141,7 @@ public:
     // the pixel, so a dimension that few of its samples reach (a deep bounce) is worked out once
     // a pixel rather than once for each half; blocks of 8 took 3% longer on path_glass.
     static constexpr int lane_bits = 4, lanes = 1 << lane_bits;
+    static_assert(lane_bits <= 4, "a base-4 digit's permutations for the lanes (2^(lane_bits - 2)) are packed a byte each in 32 bits");
 
     constexpr ZSobolSampler(std::uint64_t morton, int log2_samples, int base4_digits, const sampling::ZSobolKeys& keys)
         : morton_(morton), log2_samples_(log2_samples), base4_digits_(base4_digits), keys_(keys) {}
@@ -277,6 +270,9 @@ private:
         std::uint32_t block_digits = known.pixel_digits;
         std::array<std::uint32_t, lanes> lane_digits{};
         const int top = first_pixel_digit() - 1;
+        // Lanes are indexed in 32 bits (the index's low 32 bits are all that reach a point), so
+        // that each lane loop below is a few 8-lane vector instructions.
+        const std::uint32_t first_low = std::uint32_t(first);
         for (int digit = top; digit >= lowest_base4_digit(); --digit) {
             const int shift = digit_shift(digit);
             if (shift >= lane_bits) {
@@ -285,28 +281,34 @@ private:
                 continue;
             }
             // The permutations of the lanes: the digits above this one differ from lane to lane
-            // only in the lane bits above it (bits shift + 2 and up), so `variants` hashes.
+            // only in the lane bits above it (bits shift + 2 and up), so `variants` hashes, whose
+            // permutations' bytes are packed in one word; lane l takes byte l >> above by a shift
+            // of its own, where an array of bytes would be gathered lane by lane (GCC then left
+            // the loop scalar: 310 instructions a block at 16 samples).
             const int above = shift + 2;
-            const std::size_t variants = above >= lane_bits ? 1 : std::size_t(1) << (lane_bits - above);
-            std::array<std::uint32_t, lanes> bytes;
-            for (std::size_t v = 0; v < variants; ++v)
-                bytes[v] = sampling::base4_permutation_byte(
-                    digit == top ? known.top : permutation_above(first | (v << above), shift, known.salt));
-            for (std::size_t l = 0; l < lanes; ++l) {
-                const std::uint32_t byte = bytes[above >= lane_bits ? 0 : l >> above];
-                const std::uint32_t value = (std::uint32_t(first | l) >> shift) & 3;
-                lane_digits[l] |= ((byte >> (2 * value)) & 3) << shift;
+            const std::uint32_t variants = above >= lane_bits ? 1 : std::uint32_t(1) << (lane_bits - above);
+            std::uint32_t packed = 0;
+            for (std::uint32_t v = 0; v < variants; ++v)
+                packed |= sampling::base4_permutation_byte(
+                              digit == top ? known.top : permutation_above(first | (std::uint64_t(v) << above), shift, known.salt))
+                          << (8 * v);
+            // Not unrolled: unrolled, its lanes were left as scalar code.
+#pragma GCC unroll 1
+            for (std::uint32_t l = 0; l < std::uint32_t(lanes); ++l) {
+                const std::uint32_t value = ((first_low | l) >> shift) & 3;
+                lane_digits[l] |= ((packed >> (8 * (l >> above) + 2 * value)) & 3) << shift;
             }
         }
         if (log2_samples_ & 1) {
             if (top >= lowest_base4_digit()) {
-                // The base-2 digit's flip hashes the lane's bits above bit 0.
-                std::array<std::uint32_t, lanes / 2> flips;
-                for (std::uint64_t v = 0; v < lanes / 2; ++v)
-                    flips[v] = std::uint32_t(base2_flip(first | (v << 1), known.salt));
-                for (std::size_t l = 0; l < lanes; ++l) lane_digits[l] |= std::uint32_t(l & 1) ^ flips[l >> 1];
+                // The base-2 digit's flip hashes the lane's bits above bit 0: a bit for each pair
+                // of lanes.
+                std::uint32_t flips = 0;
+                for (std::uint32_t v = 0; v < std::uint32_t(lanes / 2); ++v)
+                    flips |= std::uint32_t(base2_flip(first | (std::uint64_t(v) << 1), known.salt)) << v;
+                for (std::uint32_t l = 0; l < std::uint32_t(lanes); ++l) lane_digits[l] |= (l & 1) ^ ((flips >> (l >> 1)) & 1);
             } else {
-                for (std::size_t l = 0; l < lanes; ++l) lane_digits[l] |= std::uint32_t((first | l) & 1) ^ known.top;
+                for (std::uint32_t l = 0; l < std::uint32_t(lanes); ++l) lane_digits[l] |= ((first_low | l) & 1) ^ known.top;
             }
         }
         for (std::size_t l = 0; l < lanes; ++l) shuffled[l] = block_digits | lane_digits[l];
