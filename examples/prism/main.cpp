@@ -6,7 +6,9 @@
 
 #include <prism/image/image_io.hpp>
 #include <prism/image/tonemap.hpp>
+#include <prism/io/element.hpp>
 #include <prism/io/limits.hpp>
+#include <prism/io/load_error.hpp>
 #include <prism/io/load.hpp>
 #include <prism/io/output_path.hpp>
 #include <prism/render/progress.hpp>

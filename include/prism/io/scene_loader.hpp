@@ -31,6 +31,7 @@
 #include <prism/io/light_loader.hpp>
 #include <prism/io/limits.hpp>
 #include <prism/io/load_error.hpp>
+#include <prism/io/load_options.hpp>
 #include <prism/io/material_loader.hpp>
 #include <prism/io/object_loader.hpp>
 #include <prism/io/texture_loader.hpp>
@@ -44,17 +45,6 @@
 #include <utility>
 
 namespace prism::io {
-
-// Choices of interpretation that the files themselves cannot settle.
-struct LoadOptions {
-    // A material with no type but a MirrorReflectance: Blinn-Phong only (false: what the
-    // course's images of 2021-2025 files show) or a mirror (true: what 2017-2019 files meant,
-    // when the course's files had no material types; cornellbox_glossy's untyped spheres with
-    // a Roughness are glossy mirrors). No file says which year's rules it follows.
-    bool untyped_mirrors_reflect = false;
-    // What a file may ask for (limits.hpp); prism --max-recursion-depth raises the depth.
-    ResourceLimits limits;
-};
 
 namespace detail::scene_loader {
 
