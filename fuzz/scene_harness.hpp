@@ -3,8 +3,8 @@
 // must not read the machine's files); a LoadError is the one allowed way to fail.
 #pragma once
 
+#include <prism/io/element.hpp>
 #include <prism/io/load_error.hpp>
-#include <prism/io/scene_loader.hpp>
 
 #include <cstddef>
 #include <cstdint>
@@ -14,13 +14,16 @@
 
 namespace prism::fuzz {
 
+// The element tree through the interpreter to the scene description. Defined once, in
+// scene_interpreter.cpp, for both harnesses: the interpreter is most of each harness's compile
+// time, and the same code in both.
+void interpret_tree(const io::Element& tree, const std::filesystem::path& path);
+
 template <class Parse>
 void interpret(const std::uint8_t* data, std::size_t size, const std::string& extension, Parse&& parse) {
     const std::filesystem::path path = "/nonexistent-prism-fuzz/scene" + extension;
     try {
-        const io::Element tree = parse(std::string_view(reinterpret_cast<const char*>(data), size), path);
-        const scene::Scene scene = io::interpret_scene(tree, path);
-        (void)scene;
+        interpret_tree(parse(std::string_view(reinterpret_cast<const char*>(data), size), path), path);
     } catch (const io::LoadError&) {
         // The expected answer to a broken file.
     }
