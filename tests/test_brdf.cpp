@@ -5,6 +5,7 @@
 // and the loader's <BRDFs> in XML and JSON with its errors.
 #include "chi_square.hpp"
 #include "temporary_folder.hpp"
+#include "text_contains.hpp"
 
 #include <prism/io/load.hpp>
 #include <prism/material/brdf.hpp>
@@ -16,9 +17,12 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <numbers>
 #include <string>
 #include <type_traits>
 #include <vector>
+
+using prism_test::contains;
 
 namespace {
 
@@ -27,7 +31,7 @@ using prism::Vec2;
 using prism::Vec3;
 using prism_test::TemporaryFolder;
 
-constexpr double pi = 3.14159265358979323846;
+using std::numbers::pi;
 
 scene::Material course_material(std::optional<scene::Brdf> brdf, double refraction_index = 1.5) {
     scene::Material material;
@@ -393,8 +397,6 @@ std::string error_of(const std::filesystem::path& file) {
     FAIL_CHECK("no LoadError for " << file);
     return "";
 }
-
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 }  // namespace
 

@@ -437,7 +437,7 @@ TEST_CASE_TEMPLATE("BVH closest hit and any hit equal brute force on a perturbed
 namespace {
 
 template <class Real>
-bool contains(const prism::Aabb<Real>& outer, const prism::Aabb<Real>& inner) {
+bool encloses(const prism::Aabb<Real>& outer, const prism::Aabb<Real>& inner) {
     return glm::all(glm::lessThanEqual(outer.min, inner.min)) && glm::all(glm::lessThanEqual(inner.max, outer.max));
 }
 
@@ -479,7 +479,7 @@ void check_structure(const prism::BvhTree<Real>& tree, const std::vector<prism::
             if (node.count > max_leaf_size) ++oversized_leaves;
             for (std::uint32_t slot = node.index; slot < node.index + node.count; ++slot) {
                 ++slot_in_leaves[slot];
-                if (!contains(node.bounds, boxes[order[slot]])) ++primitive_outside;
+                if (!encloses(node.bounds, boxes[order[slot]])) ++primitive_outside;
             }
             continue;
         }
@@ -488,7 +488,7 @@ void check_structure(const prism::BvhTree<Real>& tree, const std::vector<prism::
             continue;
         }
         for (std::uint32_t child : {node.index, node.index + 1}) {
-            if (!contains(node.bounds, nodes[child].bounds)) ++child_outside;
+            if (!encloses(node.bounds, nodes[child].bounds)) ++child_outside;
             stack.push_back({child, depth + 1});
         }
     }
@@ -502,7 +502,7 @@ void check_structure(const prism::BvhTree<Real>& tree, const std::vector<prism::
     CHECK(tree.depth() < prism::BvhTree<Real>::max_depth);
     prism::Aabb<Real> all;
     for (const auto& box : boxes) all.extend(box);
-    CHECK(contains(tree.bounds(), all));
+    CHECK(encloses(tree.bounds(), all));
 }
 
 // Whether two wide trees are the same, node for node and bit for bit: compared field by field,
@@ -1084,7 +1084,7 @@ void check_wide_structure(const prism::WideBvhTree<Real, N>& tree, const std::ve
                 ++empty_slots;
                 continue;
             }
-            if (!contains(parent_box, box)) ++child_outside;
+            if (!encloses(parent_box, box)) ++child_outside;
             if (node.count(c) == 0) {
                 stack.push_back({node.index(c), box});
                 continue;
@@ -1094,7 +1094,7 @@ void check_wide_structure(const prism::WideBvhTree<Real, N>& tree, const std::ve
             REQUIRE(first + count <= order.size());
             for (std::uint32_t slot = first; slot < first + count; ++slot) {
                 ++listed[order[slot]];
-                if (!contains(box, boxes[order[slot]])) ++primitive_outside;
+                if (!encloses(box, boxes[order[slot]])) ++primitive_outside;
             }
             for (std::uint32_t slot = first + count; slot % N != 0; ++slot)
                 if (order[slot] != order[first + count - 1]) ++bad_padding;

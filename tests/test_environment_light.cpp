@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -38,7 +39,7 @@ using Layout = scene::EnvironmentLayout;
 using Sampling = scene::EnvironmentSampling;
 using prism_test::pearson_chi_square;
 
-constexpr double pi = 3.14159265358979323846;
+using std::numbers::pi;
 
 static_assert(prism::Light<prism::EnvironmentLight<float>, float>);
 static_assert(prism::Light<prism::EnvironmentLight<double>, double>);

@@ -2,6 +2,7 @@
 // no file can make overflow the stack, outputs confined to their folder, and every input the
 // fuzzers found (tests/data/fuzz/TARGET/) replayed through the reader it broke.
 #include "temporary_folder.hpp"
+#include "text_contains.hpp"
 
 #include <prism/image/decoder_guard.hpp>
 #include <prism/image/image_io.hpp>
@@ -28,6 +29,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+using prism_test::contains;
 
 #ifndef PRISM_SOURCE_DIR
 #define PRISM_SOURCE_DIR "."
@@ -61,8 +64,6 @@ std::string refusal(const std::function<void()>& load) {
     }
     return "";
 }
-
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 }  // namespace
 

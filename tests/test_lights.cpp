@@ -3,6 +3,7 @@
 // the dispatcher's refusal to drop a light, and the loader reading the new elements (lights and
 // Tonemap) from XML and JSON.
 #include "temporary_folder.hpp"
+#include "text_contains.hpp"
 
 #include <prism/io/load.hpp>
 #include <prism/light/directional_light.hpp>
@@ -18,6 +19,8 @@
 #include <random>
 #include <sstream>
 #include <string>
+
+using prism_test::contains;
 
 namespace {
 
@@ -63,8 +66,6 @@ std::string load_error_of(const fs::path& file) {
     }
     return "no error";
 }
-
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 }  // namespace
 

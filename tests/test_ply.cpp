@@ -1,5 +1,7 @@
 // The PLY reader: every format, scalar type and list type written by the test itself, the
 // malformed files a user can hand it, and the course's real meshes when the shared data is there.
+#include "text_contains.hpp"
+
 #include <prism/io/ply.hpp>
 
 #include <doctest/doctest.h>
@@ -22,6 +24,8 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+using prism_test::contains;
 
 #ifndef PRISM_SHARED_DIR
 #define PRISM_SHARED_DIR "../shared"
@@ -181,8 +185,6 @@ std::string header(Format format, std::string_view elements) {
 fs::path write_ply(const std::string& name, Format format, std::string_view elements, const Body& body) {
     return write_file(name, header(format, elements) + body.bytes());
 }
-
-bool contains(std::string_view text, std::string_view part) { return text.find(part) != std::string_view::npos; }
 
 // Every rejection must name the file, the place, and say what is wrong.
 void check_rejects(const fs::path& path, std::string_view element, std::string_view message) {

@@ -3,6 +3,7 @@
 // kind of broken input, each of which must name the file and the element at fault.
 #include "course_manifest.hpp"
 #include "temporary_folder.hpp"
+#include "text_contains.hpp"
 
 #include <prism/io/load.hpp>
 #include <prism/math/transform.hpp>
@@ -21,6 +22,8 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+using prism_test::contains;
 
 namespace {
 
@@ -97,8 +100,6 @@ const std::map<std::string, std::vector<std::string>> known_twin_differences = {
     // The JSON adds a ninth vertex and a Plane on it.
     {"hw1/simple", {"planes: 0 against 1"}},
 };
-
-bool contains(std::string_view text, std::string_view part) { return text.find(part) != std::string_view::npos; }
 
 // ---- comparing two scenes -------------------------------------------------------------------
 

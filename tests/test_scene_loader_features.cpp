@@ -4,6 +4,7 @@
 // fault must name the file and the element. Last, every hw3, hw4 and hw5 scene of the manifest.
 #include "course_manifest.hpp"
 #include "temporary_folder.hpp"
+#include "text_contains.hpp"
 
 #include <prism/image/image_io.hpp>
 #include <prism/io/load.hpp>
@@ -23,6 +24,8 @@
 #include <string_view>
 #include <vector>
 
+using prism_test::contains;
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -32,8 +35,6 @@ using prism::io::load_scene;
 using prism::scene::Scene;
 using prism_test::TemporaryFolder;
 using Vec3 = prism::scene::Vec3;
-
-bool contains(std::string_view text, std::string_view part) { return text.find(part) != std::string_view::npos; }
 
 bool near(const Vec3& a, const Vec3& b, double tolerance = 1e-12) {
     return glm::all(glm::lessThanEqual(glm::abs(a - b), Vec3(tolerance)));

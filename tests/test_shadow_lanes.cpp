@@ -5,6 +5,8 @@
 // one batch through SceneGeometry::intersect) must get each ray's own hit, ties included.
 // And the world-space indices of one or two leaves, tested leaf by leaf in an index scene, must
 // give intersect's hits as the exhaustive test gives them.
+#include "same_bits.hpp"
+
 #include <prism/accel/accelerator.hpp>
 #include <prism/accel/wide_bvh_tree.hpp>
 #include <prism/geometry/scene_geometry.hpp>
@@ -17,11 +19,12 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <random>
 #include <set>
 #include <utility>
 #include <vector>
+
+using prism_test::same_bits;
 
 namespace {
 
@@ -33,11 +36,6 @@ glm::dvec3 random_unit(std::mt19937& random) {
         const glm::dvec3 v(normal(random), normal(random), normal(random));
         if (glm::length(v) > 1e-6) return glm::normalize(v);
     }
-}
-
-template <class Real>
-bool same_bits(Real a, Real b) {
-    return std::memcmp(&a, &b, sizeof a) == 0;
 }
 
 // A k x k grid of triangle pairs in the plane y = 0 over [0, k]^2 (x, z), raised by `bump` at

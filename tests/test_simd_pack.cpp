@@ -4,21 +4,19 @@
 // these bits. And select, lane by lane at every width the kernels use (clang 14 with libstdc++'s
 // AVX-512 masks got it wrong: simd/pack.hpp). Widths beyond one register are two halves
 // (simd/pack.hpp, needs_halves): 16 floats and 8 doubles under AVX2.
+#include "same_bits.hpp"
+
 #include <prism/simd/pack.hpp>
 
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <limits>
 
-namespace {
+using prism_test::same_bits;
 
-template <class T>
-bool same_bits(T a, T b) {
-    return std::memcmp(&a, &b, sizeof(T)) == 0;
-}
+namespace {
 
 template <class T, int N>
 void check_keep() {

@@ -10,6 +10,8 @@
 // rays tested several at a time (one batch through occluded) get what each gets alone; and a
 // world index whose root has two leaves gives a batch's rays, a ray in each lane leaf after leaf,
 // the hits and answers each gets alone, ties on the edges the leaves share included.
+#include "same_bits.hpp"
+
 #include <prism/geometry/scene_geometry.hpp>
 #include <prism/material/material.hpp>
 
@@ -21,10 +23,11 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <limits>
 #include <random>
 #include <vector>
+
+using prism_test::same_bits;
 
 namespace {
 
@@ -76,11 +79,6 @@ glm::dvec3 random_unit(std::mt19937& random) {
 scene::Scene past_direct_limit(scene::Scene world, int count) {
     for (int i = 0; i < count; ++i) world.spheres.push_back({"far", 0, {1e4 + 10 * i, 1e4, 1e4}, 1e-3, glm::dmat4(1.0)});
     return world;
-}
-
-template <class Real>
-bool same_bits(Real a, Real b) {
-    return std::memcmp(&a, &b, sizeof(Real)) == 0;
 }
 
 // Two closest hits of one ray, to the bit: the distance the ray was cut to, the triangle and
