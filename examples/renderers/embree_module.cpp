@@ -1,6 +1,8 @@
 // The shipped renderers through Embree as a module the prism renderer loads only for
 // --accelerator embree (include/prism/render/render_scene.hpp, PRISM_EMBREE_MODULE), so that its
-// other runs do not load libembree3. Built only when Embree 3 is found.
+// other runs do not load libembree3. Built only when Embree 3 is found. This file is the entry
+// point alone: the renderers are embree.cpp's (prism_embree_renderers), which the tests and
+// prism-suite link too.
 #include <prism/render/render_scene.hpp>
 
 namespace {
