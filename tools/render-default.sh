@@ -6,6 +6,6 @@ cd "$(dirname "$0")/.."
 bash tools/install-dependencies.sh
 # Sets what it needs (the examples) and leaves the tests' option as it finds it: the build
 # folder is shared with tools/test.sh, which must never inherit the tests turned off from here.
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPRISM_BUILD_EXAMPLES=ON > /dev/null
+bash tools/configure-build.sh -DPRISM_BUILD_EXAMPLES=ON
 cmake --build build --target prism-render -j "$(nproc)"
 ./build/examples/prism scenes/default.xml --output-dir out

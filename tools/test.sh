@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 bash tools/install-dependencies.sh
 # Every option the tests need is set here, not inherited: the build folder is shared with
 # tools/render-default.sh, and a cache left by another command must not turn the tests off.
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPRISM_BUILD_EXAMPLES=ON -DPRISM_BUILD_TESTS=ON > /dev/null
+bash tools/configure-build.sh -DPRISM_BUILD_EXAMPLES=ON -DPRISM_BUILD_TESTS=ON
 cmake --build build -j "$(nproc)"
 # --no-tests=error: a run that finds no test fails, instead of passing without testing.
 ctest --test-dir build --output-on-failure --no-tests=error -j "$(nproc)" "$@"
