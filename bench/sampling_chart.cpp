@@ -147,6 +147,11 @@ struct Options {
     fs::path results;
     std::string command;
     std::string revision;
+    // --samplers-only: the samplers' section alone (no RendererParams chart, no RESULTS.md);
+    // --sampler-scene: only the sampler scenes whose names contain one of these texts. At a
+    // scene's own resolution (--scale 1) the chart's defaults would take hours.
+    bool samplers_only = false;
+    std::vector<std::string> sampler_scene_filter;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -348,6 +353,7 @@ constexpr double firefly_share = 0.001;
 constexpr std::uint64_t reference_seeds[2] = {1000, 1001};
 
 struct SamplerResult {
+    std::string name;  // the scene's (sampler_scenes)
     std::vector<std::vector<Point>> points;  // [sampler][sample count]; time: the camera's render, wall
     int width = 0, height = 0;
     double reference_error = 0;
@@ -372,6 +378,7 @@ SamplerResult measure_samplers(const SamplerScene& chart_scene, const Options& o
     if (scene.cameras.empty()) fail(chart_scene.name + ": the scene has no camera");
     scene.cameras.resize(1);
     SamplerResult result;
+    result.name = chart_scene.name;
     const auto reference_start = Clock::now();
     const int half = std::max(1, options.reference_samples / 2);
     // Seeds apart from the curves' (0 to error_seeds - 1).
@@ -451,8 +458,13 @@ double error_ratio(const SamplerResult& result, std::size_t sampler, std::size_t
 std::string samplers_markdown(const std::vector<SamplerResult>& results, const Options& options,
                               const std::string& date) {
     std::ostringstream md;
-    md << "Written by the same command on " << date << " (revision `" << options.revision
-       << "`), after the RendererParams chart. Each scene's first camera, rendered as `prism` renders it "
+    if (options.samplers_only)
+        md << "Written by `" << options.command << "` on " << date << " (revision `" << options.revision
+           << "`). Each scene's first camera";
+    else
+        md << "Written by the same command on " << date << " (revision `" << options.revision
+           << "`), after the RendererParams chart. Each scene's first camera";
+    md << ", rendered as `prism` renders it "
           "(`prism::render_scene`: its own integrator and RendererParams, the shipped renderers) at `--scale "
        << options.scale << "`, with `--samples N --sampler S`; the reference: independent samples at "
        << options.reference_samples
@@ -479,7 +491,7 @@ std::string samplers_markdown(const std::vector<SamplerResult>& results, const O
     for (std::size_t s = 0; s < results.size(); ++s) {
         const SamplerResult& result = results[s];
         for (std::size_t k = 0; k < all_samplers.size(); ++k) {
-            md << "| " << (k == 0 ? sampler_scenes()[s].name + " (" + std::to_string(result.width) + "x" +
+            md << "| " << (k == 0 ? result.name + " (" + std::to_string(result.width) + "x" +
                                         std::to_string(result.height) + ")"
                                   : std::string())
                << " | " << prism::sampler_name(all_samplers[k]) << " |";
@@ -707,13 +719,17 @@ const char* usage =
     "                            [--shared DIR] [--output-dir DIR] [--results RESULTS.md] [--command TEXT]\n"
     "                            [--revision TEXT]\n"
     "                            [--sampler independent|stratified|sobol] [--project DIR]\n"
+    "                            [--samplers-only] [--sampler-scene TEXT]...\n"
     "Renders the chart's Cornell boxes with every path-tracing variant at each sample count (with\n"
     "--sampler's samples), measures each image's relative RMSE against a long MIS render, and times\n"
     "the renders; then renders four scenes as prism renders them with each sampler at each count,\n"
     "against a long independent render. Writes DIR/sampling.svg, DIR/samplers.svg, DIR/sampling.tsv\n"
     "and DIR/sampling.md, and replaces the marked section of RESULTS.md when given. Defaults:\n"
     "--scale 0.125, --samples 1,4,16,64,256, --reference-samples 8192, --runs 3 (timed runs after one\n"
-    "warm-up), --error-seeds 4 (the samplers' renders whose errors a point averages), --sampler independent, --shared " PRISM_SHARED_DIR ", --project " PRISM_SOURCE_DIR ".\n";
+    "warm-up), --error-seeds 4 (the samplers' renders whose errors a point averages), --sampler independent, --shared " PRISM_SHARED_DIR ", --project " PRISM_SOURCE_DIR ".\n"
+    "--samplers-only renders the four scenes alone and writes DIR/samplers.svg and DIR/samplers.md (not\n"
+    "RESULTS.md, whose section holds both charts); --sampler-scene TEXT keeps the scenes whose names\n"
+    "contain TEXT (metal_plates_area, glossy_area_small, path_glass, latlong; repeatable).\n";
 
 std::vector<int> parse_counts(const std::string& text) {
     std::vector<int> counts;
@@ -755,6 +771,8 @@ Options parse(int argc, char** argv) {
         else if (arg == "--results") options.results = value();
         else if (arg == "--command") options.command = value();
         else if (arg == "--revision") options.revision = value();
+        else if (arg == "--samplers-only") options.samplers_only = true;
+        else if (arg == "--sampler-scene") options.sampler_scene_filter.push_back(value());
         else if (arg == "--help" || arg == "-h") {
             std::cout << usage;
             std::exit(0);
@@ -765,6 +783,14 @@ Options parse(int argc, char** argv) {
     if (options.error_seeds < 1 || options.error_seeds > 64) fail("--error-seeds must be in [1, 64]");
     if (options.reference_samples < 4 * options.samples.back() || options.reference_samples > 65536)
         fail("--reference-samples must be in [4 x the highest --samples, 65536]");
+    if (options.samplers_only && !options.results.empty())
+        fail("--results replaces the section of both charts: not with --samplers-only");
+    for (const std::string& text : options.sampler_scene_filter) {
+        const auto& scenes = sampler_scenes();
+        if (std::none_of(scenes.begin(), scenes.end(),
+                         [&](const SamplerScene& scene) { return scene.name.find(text) != std::string::npos; }))
+            fail("--sampler-scene: no sampler scene's name contains \"" + text + "\"");
+    }
     if (options.command.empty()) options.command = "prism_sampling_chart";
     if (options.revision.empty()) options.revision = "unknown";
     return options;
@@ -780,14 +806,22 @@ int run(int argc, char** argv) {
     require_files(options.shared, files);
     fs::create_directories(options.output_dir);
 
-    for (const SamplerScene& chart_scene : sampler_scenes())
+    std::vector<SamplerScene> chosen_scenes;
+    for (const SamplerScene& chart_scene : sampler_scenes()) {
+        const auto& filter = options.sampler_scene_filter;
+        if (filter.empty() || std::any_of(filter.begin(), filter.end(), [&](const std::string& text) {
+                return chart_scene.name.find(text) != std::string::npos;
+            }))
+            chosen_scenes.push_back(chart_scene);
+    }
+    for (const SamplerScene& chart_scene : chosen_scenes)
         if (!fs::exists(sampler_scene_path(chart_scene, options)))
             fail(chart_scene.name + ": " + sampler_scene_path(chart_scene, options).string() + " not found");
     std::vector<SceneResult> results;
-    for (const ChartScene& chart_scene : chart_scenes()) results.push_back(measure_scene(chart_scene, options));
+    if (!options.samplers_only)
+        for (const ChartScene& chart_scene : chart_scenes()) results.push_back(measure_scene(chart_scene, options));
     std::vector<SamplerResult> sampler_results;
-    for (const SamplerScene& chart_scene : sampler_scenes())
-        sampler_results.push_back(measure_samplers(chart_scene, options));
+    for (const SamplerScene& chart_scene : chosen_scenes) sampler_results.push_back(measure_samplers(chart_scene, options));
 
     std::vector<Panel> panels;
     for (std::size_t s = 0; s < results.size(); ++s) {
@@ -797,7 +831,7 @@ int run(int argc, char** argv) {
     }
     std::vector<Panel> sampler_panels;
     for (std::size_t s = 0; s < sampler_results.size(); ++s) {
-        Panel panel{sampler_scenes()[s].name, sampler_results[s].reference_error, {}};
+        Panel panel{sampler_results[s].name, sampler_results[s].reference_error, {}};
         for (std::size_t k = 0; k < all_samplers.size(); ++k)
             panel.curves.push_back({&sampler_styles()[k], &sampler_results[s].points[k]});
         sampler_panels.push_back(std::move(panel));
@@ -812,6 +846,23 @@ int run(int argc, char** argv) {
 
     std::string counts;
     for (const int n : options.samples) counts += (counts.empty() ? "" : ", ") + std::to_string(n);
+    write_svg(options.output_dir / "samplers.svg", sampler_panels,
+              {"prism: error against time of its samplers", 
+               {"relative RMSE against a " + std::to_string(options.reference_samples) +
+                    "-sample independent render, the largest 0.1% of squared differences left out; " + counts +
+                    " samples per pixel",
+                "each scene at " + format_number(options.scale, 3) + " of its resolution; " +
+                    std::to_string(tbb::info::default_concurrency()) + " threads; " + cpu_model() + "; " + date},
+               "render time of the camera, wall seconds (log scale)", "--sampler", sampler_styles(),
+               "Each line joins one sampler's renders at " + counts + " samples per pixel (left to right); time: median of " +
+                   std::to_string(options.runs) + " interleaved runs of the camera's render (wall)."});
+    if (options.samplers_only) {
+        std::ofstream out(options.output_dir / "samplers.md");
+        out << samplers_markdown(sampler_results, options, date);
+        std::cerr << "wrote " << (options.output_dir / "samplers.svg").string() << " and .md in " << seconds_since(start)
+                  << " s\n";
+        return 0;
+    }
     const std::vector<std::string> subtitle{
         "relative RMSE against a " + std::to_string(options.reference_samples) + "-sample MIS render; " + counts +
             " samples per pixel; render CPU time, median of " + std::to_string(options.runs) + " runs",
@@ -824,16 +875,6 @@ int run(int argc, char** argv) {
                    " samples per pixel (left to right); time: median of " + std::to_string(options.runs) +
                    " interleaved runs, process CPU time; sampler: " +
                    std::string(prism::sampler_name(options.sampler)) + "."});
-    write_svg(options.output_dir / "samplers.svg", sampler_panels,
-              {"prism: error against time of its samplers", 
-               {"relative RMSE against a " + std::to_string(options.reference_samples) +
-                    "-sample independent render, the largest 0.1% of squared differences left out; " + counts +
-                    " samples per pixel",
-                "each scene at " + format_number(options.scale, 3) + " of its resolution; " +
-                    std::to_string(tbb::info::default_concurrency()) + " threads; " + cpu_model() + "; " + date},
-               "render time of the camera, wall seconds (log scale)", "--sampler", sampler_styles(),
-               "Each line joins one sampler's renders at " + counts + " samples per pixel (left to right); time: median of " +
-                   std::to_string(options.runs) + " interleaved runs of the camera's render (wall)."});
     write_tsv(options.output_dir / "sampling.tsv", results);
     const std::string section = markdown_section(results, options, seconds_since(start), start_load, date, checks) +
                                 "\n### The samplers (issue 32)\n\n" + samplers_markdown(sampler_results, options, date);

@@ -71,17 +71,22 @@ public:
     constexpr void start_sample(int index) {
         visit(*this, [&](auto& sampler) { sampler.start_sample(index); });
     }
-    // A draw: the independent sampler's (a step of its stream) inline at the caller, the
-    // others' longer work out of line. Through visit alone, the draw was a call of its own for
-    // every sampler (2% of path_diffuse's profile, `visit` for uniform2).
+    // A draw: the independent sampler's (a step of its stream) and sobol's (most draws read a
+    // number its block worked out already) inline at the caller; the stratified sampler's
+    // hashing and sobol's working-out of a block out of line. Through visit alone, the draw was
+    // a call of its own for every sampler (2% of path_diffuse's profile, `visit` for uniform2);
+    // sobol's reads through that call were 2% of path_glass's instructions (bench/RESULTS.md,
+    // "Sobol's cost a sample").
     template <Scalar Real>
     PRISM_FORCE_INLINE constexpr Real uniform() {
         if (kind_ == SamplerKind::independent) return independent_.template uniform<Real>();
+        if (kind_ == SamplerKind::sobol) return sobol_.template uniform<Real>();
         return structured_uniform<Real>();
     }
     template <Scalar Real>
     PRISM_FORCE_INLINE constexpr Vec2<Real> uniform2() {
         if (kind_ == SamplerKind::independent) return independent_.template uniform2<Real>();
+        if (kind_ == SamplerKind::sobol) return sobol_.template uniform2<Real>();
         return structured_uniform2<Real>();
     }
     template <Scalar Real>
