@@ -359,7 +359,8 @@ TEST_CASE_TEMPLATE("PathTracer: camera rays through the batch entries give each 
                         const int n = std::min(width, count - part);
                         const std::uint32_t found = integrator.camera_hits(rays.data() + part, hits.data() + part, n);
                         std::vector<prism::Vec3<Real>> radiance(static_cast<std::size_t>(n));
-                        integrator.radiances_at(rays.data() + part, hits.data() + part, found, n, path, radiance.data());
+                        integrator.radiances_at(rays.data() + part, hits.data() + part, found, n, path, [](int) {},
+                                                radiance.data());
                         for (int i = 0; i < n; ++i) {
                             const Real weight = prism::filter_weight(camera.filter, samples[std::size_t(part + i)].pixel);
                             sum += weight * radiance[std::size_t(i)];

@@ -23,15 +23,16 @@ namespace prism {
 //   (camera_hits: bit i of the answer set where rays[i] hits, its t_max lowered to the hit),
 //   then radiance_at from a ray's hit; radiance_row for a row's pixels of one sample each (up
 //   to row_width, `make_path(i)` giving ray i's CameraPath), radiances_at for up to
-//   prelit_width samples of one pixel, which draw from its one stream in their order, where
-//   prelights() (the Renderer calls it only for a streamed sampler, sampler_choice.hpp). Each gives radiance's bits for every ray: how side by side the work goes is
-//   the integrator's choice.
+//   prelit_width samples of one pixel, which draw from its one sampler (`path`), each after
+//   `start_sample(i)` readies that sampler for ray i (a stream's samples draw in their order:
+//   a no-op), where prelights(). Each gives radiance's bits for every ray: how side by side the
+//   work goes is the integrator's choice.
 template <class I, class Real>
 concept Integrator =
     Scalar<Real> &&
     requires(const I& integrator, const Ray<Real>& ray, Ray<Real>* rays, Hit<Real>* hits, const Hit<Real>& hit,
-             typename I::CameraPath& path, typename I::CameraPath (*make_path)(int), Vec3<Real>* radiance,
-             const scene::Camera& camera) {
+             typename I::CameraPath& path, typename I::CameraPath (*make_path)(int), void (*start_sample)(int),
+             Vec3<Real>* radiance, const scene::Camera& camera) {
         { integrator.radiance(ray, path) } -> std::same_as<Vec3<Real>>;
         { integrator.batches_camera_rays(camera) } -> std::convertible_to<bool>;
         { integrator.camera_hits(rays, hits, 1) } -> std::same_as<std::uint32_t>;
@@ -40,7 +41,7 @@ concept Integrator =
         integrator.radiance_row(rays, hits, std::uint32_t(1), 1, make_path, radiance);
         { I::prelit_width } -> std::convertible_to<int>;
         { integrator.prelights() } -> std::convertible_to<bool>;
-        integrator.radiances_at(rays, hits, std::uint32_t(1), 1, path, radiance);
+        integrator.radiances_at(rays, hits, std::uint32_t(1), 1, path, start_sample, radiance);
     };
 
 // An integrator policy: `P::template Type<Real, Geometry, LightSet, Textures, Environment,

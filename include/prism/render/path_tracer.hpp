@@ -123,14 +123,18 @@ public:
     // ray-traced camera; a path-traced camera's paths one after another, each from its hit.
     static constexpr int prelit_width = RayTracer::prelit_width;
     bool prelights() const { return whitted_.prelights(); }
+    template <class StartSample>
     void radiances_at(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count, CameraPath& path,
-                      Vec3<Real>* radiance) const {
+                      StartSample start_sample, Vec3<Real>* radiance) const {
         if (!path.renderer.path_tracing) {
             typename RayTracer::CameraPath traced = ray_traced(path);
-            whitted_.radiances_at(rays, hits, found, count, traced, radiance);
+            whitted_.radiances_at(rays, hits, found, count, traced, start_sample, radiance);
             return;
         }
-        for (int i = 0; i < count; ++i) radiance[i] = trace(rays[i], path, &hits[i], (found >> i) & 1);
+        for (int i = 0; i < count; ++i) {
+            start_sample(i);
+            radiance[i] = trace(rays[i], path, &hits[i], (found >> i) & 1);
+        }
     }
 
 private:

@@ -281,14 +281,18 @@ private:
                 Ray<Real>* const rays = scratch.rays.data() + first;
                 const std::uint32_t found = integrator_.camera_hits(rays, hits.data(), count);
                 // Where the integrator samples the lights that draw nothing for several samples
-                // first (prelights), their shadow rays go side by side: samples that draw from
-                // one stream in their order.
-                if (stream && integrator_.prelights()) {
+                // first (prelights), their shadow rays go side by side, and each sample then
+                // draws from its own start (start_sample; a stream's samples in their order).
+                // Only for a stream, the hw3-hw5 ray-traced scenes took up to 1.20 times as long
+                // with the sobol sampler (bench/RESULTS.md, "The samplers").
+                if (integrator_.prelights()) {
                     constexpr int width = Integrator::prelit_width;
                     std::array<Vec3<Real>, width> radiance;
                     for (int part = 0; part < count; part += width) {
                         const int n = std::min(width, count - part);
-                        integrator_.radiances_at(rays + part, hits.data() + part, found >> part, n, path, radiance.data());
+                        const std::size_t base = first + std::size_t(part);
+                        integrator_.radiances_at(rays + part, hits.data() + part, found >> part, n, path,
+                                                 [&](int i) { start_sample(base + std::size_t(i)); }, radiance.data());
                         for (int i = 0; i < n; ++i) {
                             const Real weight = scratch.weights[first + std::size_t(part + i)];
                             sum += weight * radiance[std::size_t(i)];

@@ -207,8 +207,9 @@ public:
     }
 
     // radiance_at for `count` (<= prelit_width) camera rays of one pixel's samples, which
-    // draw from one stream (`path`), in their order: radiance[i] for rays[i]. Each sample's
-    // draws depend on every earlier sample's, but the lights that draw nothing (point,
+    // draw from one sampler (`path`), each after `start_sample(i)` readies it for rays[i]:
+    // radiance[i] for rays[i]. A stream's draws depend on every earlier sample's (its
+    // start_sample does nothing), another sampler's on the sample alone, but the lights that draw nothing (point,
     // directional, spot: `sample(at)` alone) need no draw to be sampled: their shadow rays from
     // the samples' camera hits are made first, up to prelit_lights such lights, and tested
     // light by light as one batch each (the samples of a pixel meet nearly one point, so their
@@ -220,8 +221,9 @@ public:
     static_assert(prelit_width == row_width, "radiances_at makes point lights' rays as rows do (point_light_lanes)");
     static constexpr std::size_t prelit_lights = 8;
     bool prelights() const { return prelit_count_ > 0; }
+    template <class StartSample>
     void radiances_at(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count, CameraPath& path,
-                      Vec3<Real>* radiance) const;
+                      StartSample start_sample, Vec3<Real>* radiance) const;
 
 private:
 

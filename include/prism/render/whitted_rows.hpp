@@ -11,8 +11,10 @@
 namespace prism {
 
 template <Scalar Real, class Geometry, class LightSetT, class Textures, class Environment, class Sampler>
+template <class StartSample>
 void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment, Sampler>::radiances_at(const Ray<Real>* rays, const Hit<Real>* hits, std::uint32_t found, int count,
-                                                                                  CameraPath& path, Vec3<Real>* radiance) const {
+                                                                                  CameraPath& path, StartSample start_sample,
+                                                                                  Vec3<Real>* radiance) const {
     // shade's state at a camera hit up to its direct lighting (the point made in place).
     struct PrelitPoint {
         SurfacePoint<Real> point;
@@ -108,9 +110,11 @@ void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment, Sampler
                 if (!((blocked >> m) & 1)) points[std::size_t(owner[std::size_t(m)])].visible |= std::uint32_t(1) << j;
         }
     });
-    // Each sample shaded in its turn, as shade shades it.
+    // Each sample shaded in its turn, as shade shades it, from its own start in the sampler (the
+    // samples above drew nothing).
     for (std::uint32_t rest = shading; rest != 0; rest &= rest - 1) {
         const int i = std::countr_zero(rest);
+        start_sample(i);
         PrelitPoint& at = points[std::size_t(i)];
         const Material<Real>& material = material_of(i);
         Vec3<Real> color(0);
