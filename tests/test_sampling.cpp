@@ -21,6 +21,7 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <type_traits>
 #include <vector>
 
 namespace {
@@ -317,13 +318,16 @@ TEST_CASE_TEMPLATE("Renderer: multisampled, lens, area-lit, glossy and moving im
 TEST_CASE_TEMPLATE("Renderer: a pixel is its camera samples' filter-weighted mean, in their order, bit for bit", Real,
                    float, double) {
     // Point lights and matte surfaces draw nothing after the camera samples, so radiance() (which
-    // starts from pixel (0, 0)'s stream) gives each sample's radiance along its ray. A thin lens
-    // makes every ray depend on its lens point and the Gaussian filter weighs it. One sample
-    // (Renderer::one_sample_row: the centre, drawn in camera_samples' order, weight 1 without
-    // the filter) and 4 (a jittered grid) and 5 (n-rooks: Renderer::pixel, every sample's ray and
-    // weight made before the traces) must each add w_i L_i in camera_samples' order and divide
-    // by the sum of the weights.
-    for (const int count : {1, 4, 5}) {
+    // starts from pixel (0, 0)'s first sample) gives each sample's radiance along its ray. A thin
+    // lens makes every ray depend on its lens point and the Gaussian filter weighs it. One sample
+    // (Renderer::one_sample_row: the centre, weight 1 without the filter) and 4 (a jittered grid
+    // for the stream) and 5 (n-rooks: Renderer::pixel, every sample's ray and weight made before
+    // the traces) must each add w_i L_i in the samples' order and divide by the sum of the
+    // weights. The camera samples are the stream's (IndependentPattern: camera_samples, drawn
+    // first from the pixel's stream) or, for the default sampler (ZSobol), each sample's own
+    // camera dimensions (camera_sample).
+    const auto check = [&]<class Pattern>(int count) {
+        CAPTURE(count);
         scene::Scene world;
         scene::Camera camera = looking_down_z(24, 16);
         camera.num_samples = count;
@@ -335,17 +339,28 @@ TEST_CASE_TEMPLATE("Renderer: a pixel is its camera samples' filter-weighted mea
         world.planes.push_back({"floor", 0, {0, -1, 0}, {0, 1, 0}, glm::dmat4(1.0)});
         world.spheres.push_back({"ball", 0, {0.3, 0, 0}, 1, glm::dmat4(1.0)});
         world.point_lights.push_back({"bulb", {2, 5, 3}, {40, 40, 40}});
-        using Punctual = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::PointLightSet>;
+        using Punctual = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::PointLightSet, prism::Features{},
+                                       prism::Whitted, Pattern>;
         const prism::Renderer<Punctual> renderer(world);
         const prism::Image image = renderer.render(world.cameras[0]);
         const prism::ThinLensCamera<Real> lens(camera, camera.width, camera.height);
+        const Pattern pattern = prism::make_pattern<Pattern>({count, camera.width, camera.height, 0, {}});
         std::vector<prism::CameraSample<Real>> samples;
         std::vector<prism::Vec2<Real>> scratch;
         int mismatches = 0, lit = 0;
         for (int y = 0; y < camera.height; ++y)
             for (int x = 0; x < camera.width; ++x) {
-                prism::Random random = prism::Random::for_pixel(x, y, 0);
-                prism::camera_samples(count, random, samples, scratch);
+                if constexpr (std::is_same_v<Pattern, prism::IndependentPattern>) {
+                    prism::Random random = prism::Random::for_pixel(x, y, 0);
+                    prism::camera_samples(count, random, samples, scratch);
+                } else {
+                    auto sampler = pattern.for_pixel(x, y);
+                    samples.clear();
+                    for (int i = 0; i < count; ++i) {
+                        sampler.start_sample(i);
+                        samples.push_back(prism::camera_sample<Real>(sampler, count == 1, {true, false}));
+                    }
+                }
                 prism::Vec3<Real> sum(0);
                 Real weights = 0;
                 for (const prism::CameraSample<Real>& sample : samples) {
@@ -361,6 +376,11 @@ TEST_CASE_TEMPLATE("Renderer: a pixel is its camera samples' filter-weighted mea
             }
         CHECK(mismatches == 0);
         CHECK(lit > 50);  // the light reaches the ball and the floor
+    };
+    static_assert(std::is_same_v<prism::DefaultPattern, prism::ZSobolPattern>, "the second case is the default's");
+    for (const int count : {1, 4, 5}) {
+        check.template operator()<prism::IndependentPattern>(count);
+        check.template operator()<prism::DefaultPattern>(count);
     }
 }
 

@@ -54,12 +54,12 @@ options:
                        along the normal, as the course renders) or error-bound (past the hit
                        point's floating-point error bound: no tuned number). Default: the
                        epsilon, unless it is below 64 ulps of the scene's largest coordinate
-  --seed N             selects the pixels' random streams (default 0); any thread count gives
+  --seed N             seeds the sampler's numbers (default 0); any thread count gives
                        the same image for the same seed
   --sampler S          independent | stratified | sobol: where each sample's numbers come from
                        (the pixel's random stream; every dimension stratified across the
                        pixel's samples; Owen-scrambled Sobol' points in Morton order, pbrt-v4's
-                       ZSobol). Default: independent
+                       ZSobol). Default: sobol
   --accelerator A      prism (its own BVH; the default) or embree: Embree 3 finds the hits,
                        prism tests the triangle it finds and shades (float; only when built
                        with libembree-dev)

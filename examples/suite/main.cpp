@@ -78,8 +78,8 @@ options:
                        the scene
   --ray-offset M       scene-epsilon | error-bound: how rays leave surfaces (default: as
                        prism chooses from the scene)
-  --seed N             selects the pixels' random streams (default 0)
-  --sampler S          independent | stratified | sobol (default: independent)
+  --seed N             seeds the sampler's numbers (default 0)
+  --sampler S          independent | stratified | sobol (default: sobol)
   --cull-backfaces     camera rays ignore every triangle and plane facing away from them
   --no-cull-backfaces  camera rays see every surface from both sides (default: the course's
                        rule, back-facing triangles of every mesh; spheres and planes are

@@ -26,8 +26,11 @@ namespace prism {
 enum class SamplerKind : std::uint8_t { independent, stratified, sobol };
 
 // The kind a render uses where nobody chose one (RendererSettings::sampler left empty with the
-// ChosenPattern policy): chosen by measurement, bench/RESULTS.md "Samplers".
-inline constexpr SamplerKind default_sampler = SamplerKind::independent;
+// ChosenPattern policy), chosen by measurement (bench/RESULTS.md, "The samplers"): at 16 and 64
+// samples a pixel, each scene at its own size, sobol leaves 0.35-0.86 of independent's error for
+// 1.02-1.08 of its work, so less error at equal time on every scene measured; a one-sample pixel
+// without a lens or motion draws nothing, so hw1-hw2's images are the same with either.
+inline constexpr SamplerKind default_sampler = SamplerKind::sobol;
 
 constexpr std::string_view sampler_name(SamplerKind kind) {
     constexpr std::array<std::string_view, 3> names{"independent", "stratified", "sobol"};
@@ -183,9 +186,10 @@ Pattern make_pattern(const SamplingLayout& layout) {
 }
 
 // Without the other two samplers and the switch per draw, examples/minimal compiles in 0.3-0.6 s
-// less of its 12 s (bench/RESULTS.md, "Compile cost").
-using DefaultPattern = IndependentPattern;
-static_assert(default_sampler == SamplerKind::independent, "DefaultPattern is default_sampler's pattern");
+// less of its 12 s (bench/RESULTS.md, "Compile cost"); ZSobol's fixed pattern compiles no
+// stream routes (Renderer::can_stream), so it costs no more than the independent one did.
+using DefaultPattern = ZSobolPattern;
+static_assert(default_sampler == SamplerKind::sobol, "DefaultPattern is default_sampler's pattern");
 
 // Whether a pattern's pixel samplers draw each pixel's samples from one stream, one after
 // another (the independent sampler): the renderer then draws the camera samples from the stream
