@@ -323,7 +323,8 @@ struct SamplerScene {
 };
 
 // Area lights and glossy reflections under the ray tracer, an object light seen by glossy
-// surfaces, the path tracer through glass, and an environment light. ../shared has no course
+// surfaces, the path tracer through glass and between diffuse walls (the default sampler serves
+// both hw7 boxes), and an environment light. ../shared has no course
 // scene with an environment light (hw5's are not among its files), so that one is prism's own
 // scene in the course's format (a SphericalDirectionalLight, importance-sampled).
 const std::vector<SamplerScene>& sampler_scenes() {
@@ -334,6 +335,8 @@ const std::vector<SamplerScene>& sampler_scenes() {
          hw7_inputs + "directLighting/inputs/cornellbox_jaroslav_glossy_area_small.xml"},
         {"path_glass: path traced (NextEventEstimation)",
          hw7_inputs + "pathTracing/inputs/cornellbox_jaroslav_path_glass.xml"},
+        {"path_diffuse: path traced (NextEventEstimation), diffuse",
+         hw7_inputs + "pathTracing/inputs/cornellbox_jaroslav_path_diffuse.xml"},
         {"environment/latlong: SphericalDirectionalLight", "scenes/environment/latlong.xml", true},
     };
     return list;
@@ -722,14 +725,15 @@ const char* usage =
     "                            [--samplers-only] [--sampler-scene TEXT]...\n"
     "Renders the chart's Cornell boxes with every path-tracing variant at each sample count (with\n"
     "--sampler's samples), measures each image's relative RMSE against a long MIS render, and times\n"
-    "the renders; then renders four scenes as prism renders them with each sampler at each count,\n"
+    "the renders; then renders five scenes as prism renders them with each sampler at each count,\n"
     "against a long independent render. Writes DIR/sampling.svg, DIR/samplers.svg, DIR/sampling.tsv\n"
     "and DIR/sampling.md, and replaces the marked section of RESULTS.md when given. Defaults:\n"
     "--scale 0.125, --samples 1,4,16,64,256, --reference-samples 8192, --runs 3 (timed runs after one\n"
     "warm-up), --error-seeds 4 (the samplers' renders whose errors a point averages), --sampler independent, --shared " PRISM_SHARED_DIR ", --project " PRISM_SOURCE_DIR ".\n"
-    "--samplers-only renders the four scenes alone and writes DIR/samplers.svg and DIR/samplers.md (not\n"
+    "--samplers-only renders the sampler scenes alone and writes DIR/samplers.svg and DIR/samplers.md (not\n"
     "RESULTS.md, whose section holds both charts); --sampler-scene TEXT keeps the scenes whose names\n"
-    "contain TEXT (metal_plates_area, glossy_area_small, path_glass, latlong; repeatable).\n";
+    "contain TEXT (metal_plates_area, glossy_area_small, path_glass, path_diffuse, latlong;\n"
+    "repeatable).\n";
 
 std::vector<int> parse_counts(const std::string& text) {
     std::vector<int> counts;
