@@ -221,11 +221,16 @@ TEST_CASE_TEMPLATE("Samplers: ZSobol's blocks of samples draw each sample's numb
     // Sample counts below, at and past a block, odd and even powers of two and neither; pixels
     // at the corners; dimensions past the kept ones (cached_dimensions), each drawn as a single
     // by some samples and in a pair by others; samples drawn in an order that leaves and
-    // revisits blocks, and a sampler copied midway.
-    for (const int samples : {1, 2, 3, 5, 8, 16, 32, 37, 64, 128, 256}) {
-        const prism::ZSobolPattern pattern(samples, 300, 200, 11);
-        const ZSobolReference reference(samples, 300, 200, 11);
-        for (const std::pair<int, int>& pixel : {std::pair{0, 0}, std::pair{299, 199}, std::pair{123, 45}}) {
+    // revisits blocks, and a sampler copied midway. Images whose pattern keeps the shuffle of
+    // the pixels' top 4 digits (300 x 200: 9 digits a side) and of all of them (12 x 7), and a
+    // pixel past the image, whose prefix the pattern has not tabled.
+    for (const int samples : {1, 2, 3, 5, 8, 16, 32, 37, 64, 128, 256})
+    for (const std::pair<int, int>& size : {std::pair{300, 200}, std::pair{12, 7}}) {
+        const prism::ZSobolPattern pattern(samples, size.first, size.second, 11);
+        const ZSobolReference reference(samples, size.first, size.second, 11);
+        for (const std::pair<int, int>& pixel : {std::pair{0, 0}, std::pair{size.first - 1, size.second - 1},
+                                                 std::pair{size.first * 2 / 5, size.second / 4},
+                                                 std::pair{size.first + 5, size.second + 3}}) {
             const int x = pixel.first, y = pixel.second;
             prism::ZSobolSampler sampler = pattern.for_pixel(x, y);
             std::vector<int> order;

@@ -44,4 +44,12 @@ concept Light = Scalar<Real> && requires(const L& light, const ShadingFrame<Real
     { L::kind } -> std::convertible_to<scene::LightKind>;
 };
 
+// Whether a light type is sampled without a draw: a point, a direction or a spot (sample(at)
+// alone). An integrator skips such a light's two numbers instead of drawing them (skip<Real>(2)):
+// a stream steps past them as if drawn, so every later draw is the one it was, and a sampler
+// with dimensions works nothing out for them (a Sobol' pixel's pair of a dimension is 16 lanes'
+// points at once, which nothing would read).
+template <class L, class Real>
+inline constexpr bool sampled_without_draws = requires(const L& light, const ShadingFrame<Real>& at) { light.sample(at); };
+
 }  // namespace prism

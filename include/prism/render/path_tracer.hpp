@@ -30,6 +30,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 namespace prism {
@@ -340,7 +341,15 @@ private:
         lights_.for_each([&](const auto& light) {
             sampler.seek(light_dimension);
             light_dimension += 2;
-            const LightSample<Real> sample = light.sample({point.position, normal}, sampler.template uniform2<Real>());
+            const ShadingFrame<Real> at{point.position, normal};
+            const LightSample<Real> sample = [&] {
+                if constexpr (sampled_without_draws<std::decay_t<decltype(light)>, Real>) {
+                    sampler.template skip<Real>(2);
+                    return light.sample(at);
+                } else {
+                    return light.sample(at, sampler.template uniform2<Real>());
+                }
+            }();
             const Real cos_light = glm::dot(normal, sample.direction);
             if (cos_light <= 0 || sample.radiance == Vec3<Real>(0)) return;
             Ray<Real> shadow = leaving(point, normal, sample.direction, point.time);

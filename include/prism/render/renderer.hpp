@@ -111,7 +111,8 @@ public:
     // dimension.
     Vec3<Real> radiance(const Ray<Real>& ray) const {
         const FlushDenormals flush;  // as render() computes it
-        PixelSamplerT sampler = make_pattern<Pattern>({1, 1, 1, settings_.seed, settings_.sampler}).for_pixel(0, 0);
+        const Pattern pattern = make_pattern<Pattern>({1, 1, 1, settings_.seed, settings_.sampler});
+        PixelSamplerT sampler = pattern.for_pixel(0, 0);  // reads the pattern's tables
         sampler.start_sample(0);
         typename Integrator::CameraPath path{sampler, Vec2<Real>(Real(0.5))};
         return integrator_.radiance(ray, path);

@@ -227,14 +227,10 @@ public:
 
 private:
 
-    // The light types sampled without a draw (sample(at) alone).
-    template <class L>
-    static constexpr bool draws_nothing = requires(const L& light, const ShadingFrame<Real>& at) { light.sample(at); };
-
     static std::size_t count_prelit(const LightSetT& lights) {
         std::size_t count = 0;
         lights.for_each([&](const auto& light) {
-            if constexpr (draws_nothing<std::decay_t<decltype(light)>>) ++count;
+            if constexpr (sampled_without_draws<std::decay_t<decltype(light)>, Real>) ++count;
         });
         return std::min(count, prelit_lights);
     }
@@ -423,7 +419,7 @@ private:
         // one it was (the images stay the same).
         const ShadingFrame<Real> at{position, normal};
         const LightSample<Real> sample = [&] {
-            if constexpr (draws_nothing<L>) {
+            if constexpr (sampled_without_draws<L, Real>) {
                 sampler.template skip<Real>(2);
                 return light.sample(at);
             } else {

@@ -62,7 +62,7 @@ void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment, Sampler
         return leaving(at.point, at.normal, direction, at.point.time, at.origins).origin;
     };
     lights_.for_each([&](const auto& light) {
-        if constexpr (draws_nothing<std::decay_t<decltype(light)>>) {
+        if constexpr (sampled_without_draws<std::decay_t<decltype(light)>, Real>) {
             if (k == prelit_lights || lighting == 0) return;
             const std::size_t j = k++;
             Unconstructed<Ray<Real>, prelit_width> shadows;
@@ -124,7 +124,7 @@ void WhittedIntegrator<Real, Geometry, LightSetT, Textures, Environment, Sampler
             Vec3<Real> direct(0);
             std::size_t light_index = 0;  // among the prelit lights
             lights_.for_each([&](const auto& light) {
-                if constexpr (draws_nothing<std::decay_t<decltype(light)>>) {
+                if constexpr (sampled_without_draws<std::decay_t<decltype(light)>, Real>) {
                     if (light_index < prelit_lights) {
                         const std::size_t j = light_index++;
                         path.sampler.template skip<Real>(2);

@@ -139,13 +139,15 @@ class ChosenPattern {
 public:
     explicit ChosenPattern(const SamplingLayout& layout)
         : kind_(layout.kind.value_or(default_sampler)), independent_(layout.samples_per_pixel, layout.seed),
-          stratified_(layout.samples_per_pixel, layout.seed),
-          sobol_(layout.samples_per_pixel, layout.width, layout.height, layout.seed) {}
+          stratified_(layout.samples_per_pixel, layout.seed) {
+        // Only when chosen: its tables are worked out as it is made.
+        if (kind_ == SamplerKind::sobol) sobol_.emplace(layout.samples_per_pixel, layout.width, layout.height, layout.seed);
+    }
 
     ChosenSampler for_pixel(int x, int y) const {
         switch (kind_) {
             case SamplerKind::stratified: return ChosenSampler(stratified_.for_pixel(x, y));
-            case SamplerKind::sobol: return ChosenSampler(sobol_.for_pixel(x, y));
+            case SamplerKind::sobol: return ChosenSampler(sobol_->for_pixel(x, y));
             default: return ChosenSampler(independent_.for_pixel(x, y));
         }
     }
@@ -157,7 +159,7 @@ private:
     SamplerKind kind_;
     IndependentPattern independent_;
     StratifiedPattern stratified_;
-    ZSobolPattern sobol_;
+    std::optional<ZSobolPattern> sobol_;
 };
 
 // A pattern of the given type for a render's layout. A pattern that fixes its kind refuses

@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <memory>
 #include <utility>
+#include <vector>
 
 namespace prism {
 
@@ -126,6 +127,24 @@ struct ZSobolKeys {
     static constexpr ZSobolKeys of(std::uint64_t seed) { return {hash_key(0, seed, 1), hash_key(0, seed, 2), hash_key(0, seed, 3)}; }
 };
 
+// What a render's pixels share of each of the first dimensions, worked out once by its pattern
+// (ZSobolSampler::tables) instead of once a pixel: the dimension's keys (three mixing rounds),
+// and its shuffle of the index's top base-4 digits (at most 4), which depends on the pixel's
+// Morton prefix alone: up to 256 prefixes a dimension, where each pixel hashed each of those
+// digits for each dimension it drew (4 of the 9 pixel digits of a 512 x 512 image).
+struct ZSobolTables {
+    struct Keys {
+        std::uint64_t salt, pair;
+        std::uint32_t single;
+    };
+    static constexpr int dimensions = 64;  // ZSobolSampler::cached_dimensions
+    std::array<Keys, dimensions> keys;
+    int first_digit = 0;  // the lowest digit whose shuffle `top_digits` holds
+    int prefix_shift = 0;  // index >> prefix_shift is the prefix of those digits
+    std::uint32_t prefixes = 0;
+    std::vector<std::uint32_t> top_digits;  // [dimension * prefixes + prefix]: the shuffled digits
+};
+
 }  // namespace sampling
 
 class ZSobolSampler {
@@ -143,8 +162,31 @@ public:
     static constexpr int lane_bits = 4, lanes = 1 << lane_bits;
     static_assert(lane_bits <= 4, "a base-4 digit's permutations for the lanes (2^(lane_bits - 2)) are packed a byte each in 32 bits");
 
-    constexpr ZSobolSampler(std::uint64_t morton, int log2_samples, int base4_digits, const sampling::ZSobolKeys& keys)
-        : morton_(morton), log2_samples_(log2_samples), base4_digits_(base4_digits), keys_(keys) {}
+    // `tables` (ZSobolSampler::tables of the same keys, sample count and digits), if given,
+    // must outlive the sampler: a pattern's samplers read its tables. The same points either way.
+    constexpr ZSobolSampler(std::uint64_t morton, int log2_samples, int base4_digits, const sampling::ZSobolKeys& keys,
+                            const sampling::ZSobolTables* tables = nullptr)
+        : morton_(morton), log2_samples_(log2_samples), base4_digits_(base4_digits), keys_(keys), tables_(tables) {}
+
+    // The tables a pattern's pixels share (sampling::ZSobolTables).
+    static sampling::ZSobolTables tables(const sampling::ZSobolKeys& keys, int log2_samples, int base4_digits) {
+        sampling::ZSobolTables made;
+        const ZSobolSampler layout(0, log2_samples, base4_digits, keys);
+        made.first_digit = std::max(layout.first_pixel_digit(), base4_digits - 4);
+        made.prefix_shift = std::max(0, layout.digit_shift(made.first_digit));
+        made.prefixes = made.first_digit < base4_digits ? std::uint32_t(1) << (2 * (base4_digits - made.first_digit)) : 0;
+        made.top_digits.resize(std::size_t(made.prefixes) * sampling::ZSobolTables::dimensions);
+        for (int dimension = 0; dimension < sampling::ZSobolTables::dimensions; ++dimension) {
+            sampling::ZSobolTables::Keys& keyed = made.keys[std::size_t(dimension)];
+            keyed.salt = sampling::dimension_key(keys.salt, dimension);
+            keyed.single = std::uint32_t(sampling::dimension_key(keys.single, dimension));
+            keyed.pair = sampling::dimension_key(keys.pair, dimension);
+            for (std::uint32_t prefix = 0; prefix < made.prefixes; ++prefix)
+                made.top_digits[std::size_t(dimension) * made.prefixes + prefix] = layout.shuffled_digits(
+                    std::uint64_t(prefix) << made.prefix_shift, made.first_digit, base4_digits, keyed.salt);
+        }
+        return made;
+    }
 
     // A copy draws what the original draws: it takes the pixel, the sample and the shared parts
     // of the dimensions worked out so far, and works out its block's points again. Nothing else
@@ -152,7 +194,7 @@ public:
     // shared parts whole was 480 instructions a pixel).
     constexpr ZSobolSampler(const ZSobolSampler& other)
         : morton_(other.morton_), log2_samples_(other.log2_samples_), base4_digits_(other.base4_digits_),
-          keys_(other.keys_), dimension_(other.dimension_), lane_(other.lane_), block_(other.block_),
+          keys_(other.keys_), tables_(other.tables_), dimension_(other.dimension_), lane_(other.lane_), block_(other.block_),
           known_(other.known_) {
         for (std::uint64_t left = known_; left != 0; left &= left - 1) {
             const auto d = std::size_t(std::countr_zero(left));
@@ -343,22 +385,38 @@ private:
         return sampling::permute_base4(permutation, std::uint32_t(index >> shift) & 3) << shift;
     }
 
+    // Digits [first, last) of `index`, shuffled as every sample of its pixel shuffles them
+    // (each digit's hash depends on the digits above it, not on their shuffle); digits at or
+    // past bit 32 never reach a point.
+    // Only the digits that reach are hashed, one after another: a lane for each of 16 digits had
+    // AVX2 emulate 64-bit multiplications for every lane, reaching or not (images of up to 2^10
+    // pixels a side at 16 samples use 10).
+    constexpr std::uint32_t shuffled_digits(std::uint64_t index, int first, int last, std::uint64_t salt) const {
+        std::uint32_t digits = 0;
+        for (int digit = first; digit < last && digit_shift(digit) < 32; ++digit) {
+            const int shift = digit_shift(digit);
+            digits |= permuted_digit(index, shift, permutation_above(index, shift, salt));
+        }
+        return digits;
+    }
+
     constexpr PixelDimension shared_by_samples(int dimension) const {
         PixelDimension known;  // every member set below
-        known.salt = sampling::dimension_key(keys_.salt, dimension);
-        known.single_key = std::uint32_t(sampling::dimension_key(keys_.single, dimension));
-        known.pair_key = sampling::dimension_key(keys_.pair, dimension);
-        // The pixel's digits, shuffled as every sample of the pixel shuffles them, each digit in
-        // a lane (each digit's hash depends on the digits above it, not on their shuffle);
-        // digits at or past bit 32 never reach a point.
-        // Only the digits that reach are hashed, one after another: a lane for each of 16
-        // digits had AVX2 emulate 64-bit multiplications for every lane, reaching or not
-        // (images of up to 2^10 pixels a side at 16 samples use 10).
         const std::uint64_t index = morton_ << log2_samples_;
-        known.pixel_digits = 0;
-        for (int digit = first_pixel_digit(); digit < base4_digits_ && digit_shift(digit) < 32; ++digit) {
-            const int shift = digit_shift(digit);
-            known.pixel_digits |= permuted_digit(index, shift, permutation_above(index, shift, known.salt));
+        const std::uint64_t prefix = tables_ ? index >> tables_->prefix_shift : 0;
+        if (tables_ && std::uint32_t(dimension) < std::uint32_t(sampling::ZSobolTables::dimensions) &&
+            prefix < tables_->prefixes) {
+            const sampling::ZSobolTables::Keys& keyed = tables_->keys[std::size_t(dimension)];
+            known.salt = keyed.salt;
+            known.single_key = keyed.single;
+            known.pair_key = keyed.pair;
+            known.pixel_digits = tables_->top_digits[std::size_t(dimension) * tables_->prefixes + std::size_t(prefix)] |
+                                 shuffled_digits(index, first_pixel_digit(), tables_->first_digit, known.salt);
+        } else {
+            known.salt = sampling::dimension_key(keys_.salt, dimension);
+            known.single_key = std::uint32_t(sampling::dimension_key(keys_.single, dimension));
+            known.pair_key = sampling::dimension_key(keys_.pair, dimension);
+            known.pixel_digits = shuffled_digits(index, first_pixel_digit(), base4_digits_, known.salt);
         }
         known.top = 0;
         const int top_digit = first_pixel_digit() - 1;
@@ -380,11 +438,12 @@ private:
         return cache_[std::size_t(dimension_)];
     }
 
-    static constexpr int cached_dimensions = 64;
+    static constexpr int cached_dimensions = sampling::ZSobolTables::dimensions;
 
     std::uint64_t morton_;
     int log2_samples_, base4_digits_;
     sampling::ZSobolKeys keys_;
+    const sampling::ZSobolTables* tables_;
     int dimension_ = 0;
     int lane_ = 0;
     std::uint32_t block_ = ~std::uint32_t(0);  // the block of samples whose points pairs_ and singles_ hold
@@ -409,10 +468,14 @@ public:
         const int side = std::max({1, width, height});
         const int log2_side = std::bit_width(std::uint32_t(side - 1));
         base4_digits_ = log2_side + (log2_samples_ + 1) / 2;
+        tables_ = std::make_shared<const sampling::ZSobolTables>(ZSobolSampler::tables(keys_, log2_samples_, base4_digits_));
     }
 
+    // The pixel's sampler, which reads the pattern's tables: the pattern (or a copy of it)
+    // outlives it.
     ZSobolSampler for_pixel(int x, int y) const {
-        return ZSobolSampler(sampling::morton_2d(std::uint32_t(x), std::uint32_t(y)), log2_samples_, base4_digits_, keys_);
+        return ZSobolSampler(sampling::morton_2d(std::uint32_t(x), std::uint32_t(y)), log2_samples_, base4_digits_, keys_,
+                             tables_.get());
     }
     int samples_per_pixel() const { return samples_per_pixel_; }
 
@@ -420,6 +483,7 @@ private:
     int samples_per_pixel_;
     sampling::ZSobolKeys keys_;
     int log2_samples_ = 0, base4_digits_ = 0;
+    std::shared_ptr<const sampling::ZSobolTables> tables_;  // shared by the pattern's copies
 };
 
 }  // namespace prism
