@@ -176,14 +176,30 @@ public:
         made.prefix_shift = std::max(0, layout.digit_shift(made.first_digit));
         made.prefixes = made.first_digit < base4_digits ? std::uint32_t(1) << (2 * (base4_digits - made.first_digit)) : 0;
         made.top_digits.resize(std::size_t(made.prefixes) * sampling::ZSobolTables::dimensions);
+        std::vector<std::uint32_t> above, shuffled;
         for (int dimension = 0; dimension < sampling::ZSobolTables::dimensions; ++dimension) {
             sampling::ZSobolTables::Keys& keyed = made.keys[std::size_t(dimension)];
             keyed.salt = sampling::dimension_key(keys.salt, dimension);
             keyed.single = std::uint32_t(sampling::dimension_key(keys.single, dimension));
             keyed.pair = sampling::dimension_key(keys.pair, dimension);
-            for (std::uint32_t prefix = 0; prefix < made.prefixes; ++prefix)
-                made.top_digits[std::size_t(dimension) * made.prefixes + prefix] = layout.shuffled_digits(
-                    std::uint64_t(prefix) << made.prefix_shift, made.first_digit, base4_digits, keyed.salt);
+            // Digit by digit from the top, each prefix's shuffle from its parent's: a digit's
+            // permutation depends on the digits above it alone, so one hash serves the four
+            // values of the digit (85 hashes a dimension for 4 digits, not 1,024).
+            if (made.prefixes == 0) continue;
+            above.assign(1, 0);
+            for (int digit = base4_digits - 1; digit >= made.first_digit; --digit) {
+                const int shift = layout.digit_shift(digit);
+                shuffled.resize(above.size() * 4);
+                for (std::size_t parent = 0; parent < above.size(); ++parent) {
+                    const std::uint64_t index = shift + 2 >= 64 ? 0 : std::uint64_t(parent) << (shift + 2);
+                    const std::uint32_t permutation = permutation_above(index, shift, keyed.salt);
+                    for (std::uint32_t value = 0; value < 4; ++value)
+                        shuffled[4 * parent + value] =
+                            above[parent] | (shift < 32 ? sampling::permute_base4(permutation, value) << shift : 0);
+                }
+                std::swap(above, shuffled);
+            }
+            std::copy(above.begin(), above.end(), made.top_digits.begin() + std::ptrdiff_t(dimension) * made.prefixes);
         }
         return made;
     }
