@@ -28,7 +28,7 @@ enum class SamplerKind : std::uint8_t { independent, stratified, sobol };
 // The kind a render uses where nobody chose one (RendererSettings::sampler left empty with the
 // ChosenPattern policy), chosen by measurement (bench/RESULTS.md, "The samplers"): at 16 and 64
 // samples a pixel, each scene at its own size, sobol leaves 0.35-0.86 of independent's error for
-// 1.02-1.08 of its work, so less error at equal time on every scene measured; a one-sample pixel
+// 1.02-1.07 of its work, so less error at equal time on every scene measured; a one-sample pixel
 // without a lens or motion draws nothing, so hw1-hw2's images are the same with either.
 inline constexpr SamplerKind default_sampler = SamplerKind::sobol;
 
