@@ -168,6 +168,13 @@ static_assert(prism::PixelSampler<prism::StratifiedSampler, float>);
 static_assert(prism::SamplerPattern<prism::IndependentPattern, float>);
 static_assert(prism::SamplerPattern<prism::ZSobolPattern, float>);
 static_assert(prism::SamplerPattern<prism::StratifiedPattern, double>);
+// A pixel's ZSobol sampler reads its pattern's tables, so a pattern about to end makes none
+// (for_pixel const&& deleted); a stream's pattern holds nothing its samplers read.
+template <class P>
+concept makes_sampler_as_temporary = requires(int x) { std::declval<const P&&>().for_pixel(x, x); };
+static_assert(!makes_sampler_as_temporary<prism::ZSobolPattern>);
+static_assert(!makes_sampler_as_temporary<prism::ChosenPattern>);
+static_assert(makes_sampler_as_temporary<prism::IndependentPattern>);
 
 TEST_CASE("Samplers: Sobol' dimensions 0 and 1 give the published first points") {
     // The unscrambled two-dimensional Sobol' points 0-15 in Gray-code order (Bratley and Fox's
@@ -495,25 +502,31 @@ TEST_CASE_TEMPLATE("Samplers: the run-time choice draws what the chosen sampler 
         return differ;
     };
     const prism::SamplingLayout layout{6, 20, 10, 17, {}};
+    // Patterns outlive their samplers (a temporary pattern makes none: for_pixel const&&).
+    prism::SamplingLayout chosen_independent = layout, chosen_stratified = layout, chosen_sobol = layout,
+                          defaulted = layout;
+    chosen_independent.kind = prism::SamplerKind::independent;
+    chosen_stratified.kind = prism::SamplerKind::stratified;
+    chosen_sobol.kind = prism::SamplerKind::sobol;
+    defaulted.kind = prism::default_sampler;  // left open, the kind is default_sampler
+    const prism::ChosenPattern as_independent(chosen_independent), as_stratified(chosen_stratified),
+        as_sobol(chosen_sobol), left_open(layout), as_default(defaulted);
+    const prism::IndependentPattern independent(6, 17);
+    const prism::StratifiedPattern stratified(6, 17);
+    const prism::ZSobolPattern sobol_pattern(6, 20, 10, 17);
     for (const auto& [x, y] : {std::pair{0, 0}, std::pair{3, 9}, std::pair{19, 4}}) {
-        prism::SamplingLayout chosen = layout;
-        chosen.kind = prism::SamplerKind::independent;
-        CHECK(same_draws(prism::ChosenPattern(chosen).for_pixel(x, y), prism::IndependentPattern(6, 17).for_pixel(x, y)) == 0);
-        chosen.kind = prism::SamplerKind::stratified;
-        CHECK(same_draws(prism::ChosenPattern(chosen).for_pixel(x, y), prism::StratifiedPattern(6, 17).for_pixel(x, y)) == 0);
-        chosen.kind = prism::SamplerKind::sobol;
-        CHECK(same_draws(prism::ChosenPattern(chosen).for_pixel(x, y), prism::ZSobolPattern(6, 20, 10, 17).for_pixel(x, y)) == 0);
-        // Left open, the kind is default_sampler.
-        prism::SamplingLayout defaulted = layout;
-        defaulted.kind = prism::default_sampler;
-        CHECK(same_draws(prism::ChosenPattern(layout).for_pixel(x, y), prism::ChosenPattern(defaulted).for_pixel(x, y)) == 0);
+        CHECK(same_draws(as_independent.for_pixel(x, y), independent.for_pixel(x, y)) == 0);
+        CHECK(same_draws(as_stratified.for_pixel(x, y), stratified.for_pixel(x, y)) == 0);
+        CHECK(same_draws(as_sobol.for_pixel(x, y), sobol_pattern.for_pixel(x, y)) == 0);
+        CHECK(same_draws(left_open.for_pixel(x, y), as_default.for_pixel(x, y)) == 0);
     }
     // A stream ignores seek and has no dimensions; the others go where they are sent.
     prism::IndependentSampler stream = prism::IndependentPattern(1, 3).for_pixel(2, 2), unmoved = stream;
     stream.seek(12);
     CHECK(stream.dimension() == 0);
     CHECK(stream.template uniform<Real>() == unmoved.template uniform<Real>());
-    prism::ZSobolSampler sobol = prism::ZSobolPattern(4, 4, 4, 3).for_pixel(1, 1), walked = sobol;
+    const prism::ZSobolPattern small(4, 4, 4, 3);
+    prism::ZSobolSampler sobol = small.for_pixel(1, 1), walked = sobol;
     sobol.start_sample(2);
     walked.start_sample(2);
     sobol.seek(9);

@@ -144,13 +144,15 @@ public:
         if (kind_ == SamplerKind::sobol) sobol_.emplace(layout.samples_per_pixel, layout.width, layout.height, layout.seed);
     }
 
-    ChosenSampler for_pixel(int x, int y) const {
+    // As ZSobolPattern's: the pattern outlives its pixels' samplers.
+    ChosenSampler for_pixel(int x, int y) const& {
         switch (kind_) {
             case SamplerKind::stratified: return ChosenSampler(stratified_.for_pixel(x, y));
             case SamplerKind::sobol: return ChosenSampler(sobol_->for_pixel(x, y));
             default: return ChosenSampler(independent_.for_pixel(x, y));
         }
     }
+    ChosenSampler for_pixel(int x, int y) const&& = delete;
     int samples_per_pixel() const { return independent_.samples_per_pixel(); }
     // Whether the pixel's samples draw from one stream in order (see streamed()).
     bool streamed() const { return kind_ == SamplerKind::independent; }

@@ -488,11 +488,13 @@ public:
     }
 
     // The pixel's sampler, which reads the pattern's tables: the pattern (or a copy of it)
-    // outlives it.
-    ZSobolSampler for_pixel(int x, int y) const {
+    // outlives it, so a pattern about to end makes none (the sanitizers' build caught a test's
+    // sampler drawing from its temporary pattern's freed tables).
+    ZSobolSampler for_pixel(int x, int y) const& {
         return ZSobolSampler(sampling::morton_2d(std::uint32_t(x), std::uint32_t(y)), log2_samples_, base4_digits_, keys_,
                              tables_.get());
     }
+    ZSobolSampler for_pixel(int x, int y) const&& = delete;
     int samples_per_pixel() const { return samples_per_pixel_; }
 
 private:
