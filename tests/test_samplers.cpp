@@ -104,40 +104,26 @@ std::pair<double, bool> dimension_correlation(const Pattern& pattern, int sample
 }
 
 // ZSobol's numbers by their definition, one sample at a time (sampling/sobol.hpp): the index
-// (morton(x, y) << log2 spp) | sample with every base-4 digit, from the top, permuted by the
-// lexicographic permutation a hash of the original digits above it picks; with an odd log2, the
-// lowest (base-2) digit flipped by a hash bit; then Sobol' dimension 0 (and 1, for a pair)
-// Owen-scrambled with the dimension's keys. Nothing cached, nothing shared by a block.
+// (morton(x, y) << log2 spp) | sample, as a 32-bit integer, with each bit from the top flipped by
+// a hash of the bits above it and the dimension's salt (a nested uniform scramble: Owen's
+// scramble of the index read as a fraction); then Sobol' dimension 0 (and 1,
+// for a pair) Owen-scrambled with the dimension's keys. Nothing cached, nothing shared by a
+// block.
 struct ZSobolReference {
-    int log2_samples, base4_digits;
+    int log2_samples;
     prism::sampling::ZSobolKeys keys;
 
-    ZSobolReference(int samples, int width, int height, std::uint64_t seed) : keys(prism::sampling::ZSobolKeys::of(seed)) {
+    ZSobolReference(int samples, int, int, std::uint64_t seed) : keys(prism::sampling::ZSobolKeys::of(seed)) {
         log2_samples = 0;
         while ((1 << log2_samples) < samples) ++log2_samples;
-        int log2_side = 0;
-        while ((1 << log2_side) < std::max(width, height)) ++log2_side;
-        base4_digits = log2_side + (log2_samples + 1) / 2;
     }
     std::uint32_t index(int x, int y, int sample, int dimension) const {
-        using prism::mix_bits;
-        std::vector<std::array<std::uint32_t, 4>> permutations;
-        std::array<std::uint32_t, 4> p{0, 1, 2, 3};
-        do permutations.push_back(p);
-        while (std::next_permutation(p.begin(), p.end()));
         const std::uint64_t salt = prism::sampling::dimension_key(keys.salt, dimension);
         const std::uint64_t original =
             (prism::sampling::morton_2d(std::uint32_t(x), std::uint32_t(y)) << log2_samples) | std::uint32_t(sample);
-        const bool odd = log2_samples & 1;
-        std::uint64_t shuffled = 0;
-        for (int digit = base4_digits - 1; digit >= int(odd); --digit) {
-            const int shift = 2 * digit - int(odd);
-            const std::uint64_t above = original >> (shift + 2);
-            const std::size_t permutation = std::size_t((mix_bits(above ^ salt) >> 40) % 24);
-            shuffled |= std::uint64_t(permutations[permutation][(original >> shift) & 3]) << shift;
-        }
-        if (odd) shuffled |= (original & 1) ^ (mix_bits((original >> 1) ^ salt) >> 63);
-        return std::uint32_t(shuffled);
+        const std::uint64_t above = original >> 32;
+        const std::uint32_t key = std::uint32_t(above == 0 ? salt : prism::mix_bits(salt ^ above));
+        return prism::sampling::owen_scramble(std::uint32_t(original), key);
     }
     template <class Real>
     Real single(int x, int y, int sample, int dimension) const {
@@ -228,16 +214,15 @@ TEST_CASE_TEMPLATE("Samplers: ZSobol's blocks of samples draw each sample's numb
     // Sample counts below, at and past a block, odd and even powers of two and neither; pixels
     // at the corners; dimensions past the kept ones (cached_dimensions), each drawn as a single
     // by some samples and in a pair by others; samples drawn in an order that leaves and
-    // revisits blocks, and a sampler copied midway. Images whose pattern keeps the shuffle of
-    // the pixels' top 4 digits (300 x 200: 9 digits a side) and of all of them (12 x 7), and a
-    // pixel past the image, whose prefix the pattern has not tabled.
+    // revisits blocks, and a sampler copied midway. Two image sizes, a pixel past the image,
+    // and one whose index reaches past 32 bits (its bits above them go into the shuffle's key).
     for (const int samples : {1, 2, 3, 5, 8, 16, 32, 37, 64, 128, 256})
     for (const std::pair<int, int>& size : {std::pair{300, 200}, std::pair{12, 7}}) {
         const prism::ZSobolPattern pattern(samples, size.first, size.second, 11);
         const ZSobolReference reference(samples, size.first, size.second, 11);
         for (const std::pair<int, int>& pixel : {std::pair{0, 0}, std::pair{size.first - 1, size.second - 1},
                                                  std::pair{size.first * 2 / 5, size.second / 4},
-                                                 std::pair{size.first + 5, size.second + 3}}) {
+                                                 std::pair{size.first + 5, size.second + 3}, std::pair{70000, 70001}}) {
             const int x = pixel.first, y = pixel.second;
             prism::ZSobolSampler sampler = pattern.for_pixel(x, y);
             std::vector<int> order;

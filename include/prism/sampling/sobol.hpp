@@ -1,17 +1,19 @@
 // Owen-scrambled Sobol' points with the pixels in Morton order: the design of Ahmed and Wonka,
 // "Screen-Space Blue-Noise Diffusion of Monte Carlo Sampling Error via Hierarchical Ordering of
 // Pixels" (SIGGRAPH Asia 2020), as pbrt-v4's ZSobolSampler uses it (Pharr, Jakob and Humphreys,
-// 4th ed., sec. 8.7.7).
+// 4th ed., sec. 8.7.7), with the index shuffled by a nested uniform scramble (Burley,
+// "Practical Hash-based Owen Scrambling", JCGT 2020, sec. 5) rather than by hashed base-4 digit
+// permutations.
 //
 // Every dimension (or pair of dimensions) is a (0, 2)-sequence: the first two Sobol' dimensions,
 // each scrambled with its own seed. Sample i of pixel (x, y) is point (morton(x, y) << log2 spp)
 // + i of it, so the pixel's samples are one aligned block of the sequence, which is a (0, m, 2)-net
-// for 2^m samples: stratified in every elementary interval. Before it is used the index has its
-// base-4 digits shuffled, each by one of the 24 permutations of {0, 1, 2, 3} chosen by a hash of
-// the digits above it and of the dimension: neighbouring pixels (neighbours in Morton order) take
-// different parts of the sequence, and so their errors differ in the way blue noise does, while
-// each pixel's block stays a block. Dimensions are padded with independent scrambles rather than
-// taken from higher Sobol' dimensions, whose 2D projections are poorer.
+// for 2^m samples: stratified in every elementary interval. Before it is used the index is
+// shuffled by a nested uniform scramble keyed by the dimension: each bit flipped by a hash of the
+// bits above it, so each pixel's block goes to another aligned block (still a net), neighbouring
+// pixels (neighbours in Morton order) take distinct parts of their parent's block, and so their
+// errors differ in the way blue noise does. Dimensions are padded with independent scrambles
+// rather than taken from higher Sobol' dimensions, whose 2D projections are poorer.
 #pragma once
 
 #include <prism/sampling/sampler.hpp>
@@ -22,7 +24,6 @@
 #include <cstdint>
 #include <memory>
 #include <utility>
-#include <vector>
 
 namespace prism {
 
@@ -99,27 +100,6 @@ constexpr std::uint64_t morton_2d(std::uint32_t x, std::uint32_t y) {
     return spread(x) | (spread(y) << 1);
 }
 
-// The 24 permutations of {0, 1, 2, 3}, in lexicographic order, a byte each (two bits a digit):
-// the digit a permutation makes of digit d is bits 2d and 2d + 1 of its byte. ZSobolSampler's
-// blocks pack the bytes their lanes need into one word, from which each lane shifts its own.
-constexpr std::array<std::uint8_t, 24> base4_permutations() {
-    std::array<std::uint8_t, 24> bytes{};
-    std::array<std::uint8_t, 4> p{0, 1, 2, 3};
-    for (std::size_t permutation = 0; permutation < 24; ++permutation) {
-        for (std::size_t digit = 0; digit < 4; ++digit) bytes[permutation] |= std::uint8_t(p[digit] << (2 * digit));
-        std::next_permutation(p.begin(), p.end());
-    }
-    return bytes;
-}
-inline constexpr std::array<std::uint8_t, 24> base4_permutation_bytes = base4_permutations();
-
-// Permutation `permutation` (0-23) as its byte.
-constexpr std::uint32_t base4_permutation_byte(std::uint32_t permutation) { return base4_permutation_bytes[permutation]; }
-// Digit `digit` (0-3) under permutation `permutation` (0-23).
-constexpr std::uint32_t permute_base4(std::uint32_t permutation, std::uint32_t digit) {
-    return (base4_permutation_byte(permutation) >> (2 * digit)) & 3;
-}
-
 // The seed's hashes for single dimensions, pairs and the index shuffle's salt, which each
 // dimension's keys start from (dimension_key): hashed once a render, by the pattern.
 struct ZSobolKeys {
@@ -127,22 +107,22 @@ struct ZSobolKeys {
     static constexpr ZSobolKeys of(std::uint64_t seed) { return {hash_key(0, seed, 1), hash_key(0, seed, 2), hash_key(0, seed, 3)}; }
 };
 
+// A dimension's keys: the index shuffle's salt and the points' scrambles (single, and the pair's
+// two halves).
+struct ZSobolDimension {
+    std::uint64_t salt, pair;
+    std::uint32_t single;
+    static constexpr ZSobolDimension of(const ZSobolKeys& keys, int dimension) {
+        return {dimension_key(keys.salt, dimension), dimension_key(keys.pair, dimension),
+                std::uint32_t(dimension_key(keys.single, dimension))};
+    }
+};
+
 // What a render's pixels share of each of the first dimensions, worked out once by its pattern
-// (ZSobolSampler::tables) instead of once a pixel: the dimension's keys (three mixing rounds),
-// and its shuffle of the index's top base-4 digits (at most 4), which depends on the pixel's
-// Morton prefix alone: up to 256 prefixes a dimension, where each pixel hashed each of those
-// digits for each dimension it drew (4 of the 9 pixel digits of a 512 x 512 image).
+// (ZSobolSampler::tables) instead of once a pixel: the dimension's keys (three mixing rounds).
 struct ZSobolTables {
-    struct Keys {
-        std::uint64_t salt, pair;
-        std::uint32_t single;
-    };
     static constexpr int dimensions = 64;  // ZSobolSampler::cached_dimensions
-    std::array<Keys, dimensions> keys;
-    int first_digit = 0;  // the lowest digit whose shuffle `top_digits` holds
-    int prefix_shift = 0;  // index >> prefix_shift is the prefix of those digits
-    std::uint32_t prefixes = 0;
-    std::vector<std::uint32_t> top_digits;  // [dimension * prefixes + prefix]: the shuffled digits
+    std::array<ZSobolDimension, dimensions> keys;
 };
 
 }  // namespace sampling
@@ -153,70 +133,31 @@ public:
     // a pixel run one after another, and each use of a number takes the same dimension in each,
     // so a dimension's first draw in a block of `lanes` samples works out the block's points in
     // plain loops over the lanes, which the compiler vectorises, and the block's other samples
-    // read theirs. One sample at a time, each draw waited for its own chain of hashes, bit
-    // reversals and multiplications: 14% of hw7 path_glass's render and 22% of
-    // scenes/environment/latlong's with this sampler (perf, 16 and 256 samples).
-    // Sixteen lanes, one 64-byte register of 32-bit values: at 16 samples a pixel one block is
-    // the pixel, so a dimension that few of its samples reach (a deep bounce) is worked out once
-    // a pixel rather than once for each half; blocks of 8 took 3% longer on path_glass.
+    // read theirs. Sixteen lanes, one 64-byte register of 32-bit values: at 16 samples a pixel
+    // one block is the pixel, so a dimension that few of its samples reach (a deep bounce) is
+    // worked out once a pixel rather than once for each half.
     static constexpr int lane_bits = 4, lanes = 1 << lane_bits;
-    static_assert(lane_bits <= 4, "a base-4 digit's permutations for the lanes (2^(lane_bits - 2)) are packed a byte each in 32 bits");
 
-    // `tables` (ZSobolSampler::tables of the same keys, sample count and digits), if given,
-    // must outlive the sampler: a pattern's samplers read its tables. The same points either way.
-    constexpr ZSobolSampler(std::uint64_t morton, int log2_samples, int base4_digits, const sampling::ZSobolKeys& keys,
+    // `tables` (ZSobolSampler::tables of the same keys), if given, must outlive the sampler: a
+    // pattern's samplers read its tables. The same points either way.
+    constexpr ZSobolSampler(std::uint64_t morton, int log2_samples, const sampling::ZSobolKeys& keys,
                             const sampling::ZSobolTables* tables = nullptr)
-        : morton_(morton), log2_samples_(log2_samples), base4_digits_(base4_digits), keys_(keys), tables_(tables) {}
+        : morton_(morton), log2_samples_(log2_samples), keys_(keys), tables_(tables) {}
 
-    // The tables a pattern's pixels share (sampling::ZSobolTables).
-    static sampling::ZSobolTables tables(const sampling::ZSobolKeys& keys, int log2_samples, int base4_digits) {
+    // The keys a pattern's pixels share (sampling::ZSobolTables).
+    static sampling::ZSobolTables tables(const sampling::ZSobolKeys& keys) {
         sampling::ZSobolTables made;
-        const ZSobolSampler layout(0, log2_samples, base4_digits, keys);
-        made.first_digit = std::max(layout.first_pixel_digit(), base4_digits - 4);
-        made.prefix_shift = std::max(0, layout.digit_shift(made.first_digit));
-        made.prefixes = made.first_digit < base4_digits ? std::uint32_t(1) << (2 * (base4_digits - made.first_digit)) : 0;
-        made.top_digits.resize(std::size_t(made.prefixes) * sampling::ZSobolTables::dimensions);
-        std::vector<std::uint32_t> above, shuffled;
-        for (int dimension = 0; dimension < sampling::ZSobolTables::dimensions; ++dimension) {
-            sampling::ZSobolTables::Keys& keyed = made.keys[std::size_t(dimension)];
-            keyed.salt = sampling::dimension_key(keys.salt, dimension);
-            keyed.single = std::uint32_t(sampling::dimension_key(keys.single, dimension));
-            keyed.pair = sampling::dimension_key(keys.pair, dimension);
-            // Digit by digit from the top, each prefix's shuffle from its parent's: a digit's
-            // permutation depends on the digits above it alone, so one hash serves the four
-            // values of the digit (85 hashes a dimension for 4 digits, not 1,024).
-            if (made.prefixes == 0) continue;
-            above.assign(1, 0);
-            for (int digit = base4_digits - 1; digit >= made.first_digit; --digit) {
-                const int shift = layout.digit_shift(digit);
-                shuffled.resize(above.size() * 4);
-                for (std::size_t parent = 0; parent < above.size(); ++parent) {
-                    const std::uint64_t index = shift + 2 >= 64 ? 0 : std::uint64_t(parent) << (shift + 2);
-                    const std::uint32_t permutation = permutation_above(index, shift, keyed.salt);
-                    for (std::uint32_t value = 0; value < 4; ++value)
-                        shuffled[4 * parent + value] =
-                            above[parent] | (shift < 32 ? sampling::permute_base4(permutation, value) << shift : 0);
-                }
-                std::swap(above, shuffled);
-            }
-            std::copy(above.begin(), above.end(), made.top_digits.begin() + std::ptrdiff_t(dimension) * made.prefixes);
-        }
+        for (int dimension = 0; dimension < sampling::ZSobolTables::dimensions; ++dimension)
+            made.keys[std::size_t(dimension)] = sampling::ZSobolDimension::of(keys, dimension);
         return made;
     }
 
-    // A copy draws what the original draws: it takes the pixel, the sample and the shared parts
-    // of the dimensions worked out so far, and works out its block's points again. Nothing else
-    // is copied (16 KB, of which a new pixel's sampler holds nothing yet: copying the 2 KB of
-    // shared parts whole was 480 instructions a pixel).
+    // A copy draws what the original draws: it takes the pixel and the sample, and works out
+    // its block's points again. Nothing else is copied (12 KB, of which a new pixel's sampler
+    // holds nothing yet).
     constexpr ZSobolSampler(const ZSobolSampler& other)
-        : morton_(other.morton_), log2_samples_(other.log2_samples_), base4_digits_(other.base4_digits_),
-          keys_(other.keys_), tables_(other.tables_), dimension_(other.dimension_), lane_(other.lane_), block_(other.block_),
-          known_(other.known_) {
-        for (std::uint64_t left = known_; left != 0; left &= left - 1) {
-            const auto d = std::size_t(std::countr_zero(left));
-            cache_[d] = other.cache_[d];
-        }
-    }
+        : morton_(other.morton_), log2_samples_(other.log2_samples_), keys_(other.keys_), tables_(other.tables_),
+          dimension_(other.dimension_), lane_(other.lane_), block_(other.block_) {}
     constexpr ZSobolSampler& operator=(const ZSobolSampler& other) {
         if (this != &other) std::construct_at(this, other);  // every member is trivially destroyed
         return *this;
@@ -258,20 +199,6 @@ public:
     constexpr void seek(int dimension) { dimension_ = dimension; }
 
 private:
-    // What a dimension's draws share across the pixel's samples: its keys (one mixing round
-    // each, dimension_key), and the shuffle of every index digit made of the pixel's bits, with
-    // the highest digit made of the sample's bits, whose permutation is chosen by the pixel's
-    // bits alone. Worked out once a pixel and dimension (for the first cached_dimensions), each
-    // block of samples then hashes only the digits its samples differ in (point_indices).
-    // No member initialisers: the cache's 64 entries are written as their dimensions are first
-    // drawn (shared_by_samples sets every member), not zeroed for each pixel's sampler.
-    struct PixelDimension {
-        std::uint64_t salt, pair_key;
-        std::uint32_t single_key;
-        std::uint32_t pixel_digits;  // only the low 32 bits of the index reach a point
-        std::uint8_t top;            // the top sample digit's permutation, or the base-2 flip
-    };
-
     // A block's points of one dimension taken as pairs, lane by lane.
     struct Pairs {
         std::array<std::uint32_t, lanes> x, y;
@@ -285,214 +212,96 @@ private:
 
     // A draw whose block has not worked out its dimension yet: the block's points, kept for its
     // other samples, or for a dimension past cached_dimensions, worked out and not kept. Out of
-    // line, so that a draw of points already worked out is a load where the caller draws (one
-    // draw in six on hw7 path_glass at 16 samples works a block out).
+    // line, so that a draw of points already worked out is a load where the caller draws.
     [[gnu::noinline]] constexpr std::uint32_t single_worked_out() {
         std::array<std::uint32_t, lanes> uncached;
         std::array<std::uint32_t, lanes>& block = cached() ? singles_[std::size_t(dimension_)] : uncached;
-        singles(pixel_dimension(), block);
+        singles(dimension_keys(), block);
         if (cached()) singles_known_ |= std::uint64_t(1) << dimension_;
         return block[std::size_t(lane_)];
     }
     [[gnu::noinline]] constexpr std::pair<std::uint32_t, std::uint32_t> pair_worked_out() {
         Pairs uncached;
         Pairs& block = cached() ? pairs_[std::size_t(dimension_)] : uncached;
-        pairs(pixel_dimension(), block);
+        pairs(dimension_keys(), block);
         if (cached()) pairs_known_ |= std::uint64_t(1) << dimension_;
         return {block.x[std::size_t(lane_)], block.y[std::size_t(lane_)]};
     }
 
-    // Dimension `known`'s numbers of the block's samples: as single dimensions (Sobol'
-    // dimension 0 of the shuffled index, which is the index reversed, so scrambled as it is), or
-    // as pairs (dimensions 0 and 1, each with its key). Always all the lanes, so that each loop
-    // is a few vector instructions with no remainder: with fewer than `lanes` samples a pixel,
-    // the block's lanes past them are worked out and never read.
-    constexpr void singles(const PixelDimension& known, std::array<std::uint32_t, lanes>& bits) const {
+    // The current dimension's keys: the pattern's, or worked out past its tables.
+    constexpr sampling::ZSobolDimension dimension_keys() const {
+        if (tables_ && cached()) return tables_->keys[std::size_t(dimension_)];
+        return sampling::ZSobolDimension::of(keys_, dimension_);
+    }
+
+    // Dimension `keys`' numbers of the block's samples: as single dimensions (Sobol' dimension 0
+    // of the shuffled index, which is the index reversed, so scrambled as it is), or as pairs
+    // (dimensions 0 and 1, each with its key). Always all the lanes, so that each loop is a few
+    // vector instructions with no remainder: with fewer than `lanes` samples a pixel, the
+    // block's lanes past them are worked out and never read.
+    constexpr void singles(const sampling::ZSobolDimension& keys, std::array<std::uint32_t, lanes>& bits) const {
         std::array<std::uint32_t, lanes> index;
-        point_indices(known, index);
-        const std::uint32_t key = known.single_key;  // read once: `bits` could alias `known`
+        point_indices(keys.salt, index);
+        const std::uint32_t key = keys.single;
         for (std::size_t l = 0; l < lanes; ++l) bits[l] = sampling::owen_scramble_reversed(index[l], key);
     }
-    constexpr void pairs(const PixelDimension& known, Pairs& block) const {
+    constexpr void pairs(const sampling::ZSobolDimension& keys, Pairs& block) const {
         std::array<std::uint32_t, lanes> index;
-        point_indices(known, index);
-        const std::uint32_t x_key = std::uint32_t(known.pair_key), y_key = std::uint32_t(known.pair_key >> 32);  // read once
+        point_indices(keys.salt, index);
+        const std::uint32_t x_key = std::uint32_t(keys.pair), y_key = std::uint32_t(keys.pair >> 32);
         for (std::size_t l = 0; l < lanes; ++l) block.x[l] = sampling::owen_scramble_reversed(index[l], x_key);
         for (std::size_t l = 0; l < lanes; ++l)
             block.y[l] = sampling::owen_scramble_reversed(sampling::sobol_dimension1_reversed(index[l]), y_key);
     }
 
-    // The Sobol' indices the dimension takes for the block's samples: each sample's index with
-    // its base-4 digits shuffled, from the top, each by a permutation chosen by a hash of the
-    // (original) digits above it, the dimension and the seed. With an odd log2 of the sample
-    // count the lowest digit is base 2, flipped by a hash bit. Only the low 32 bits reach a
-    // 32-bit fraction (sobol_dimension0/1), as in any 32-bit Sobol' generator.
-    // The block's samples differ only in their lowest lane_bits bits, so a digit above those is
-    // the block's and is shuffled once for all of them; a digit within them is shuffled lane by
-    // lane, by a permutation that depends on at most the lane's bits 2 and 3 (four hashes), and
-    // the base-2 digit's flip on its bits 1 to 3 (eight). Lane by lane, every digit took a hash:
-    // a block of 256-sample pixels hashed 48 times where 6 hashes are needed.
-    constexpr void point_indices(const PixelDimension& known, std::array<std::uint32_t, lanes>& shuffled) const {
+    // The Sobol' indices the dimension takes for the block's samples: each sample's index
+    // (morton << log2 spp) + sample, shuffled by a nested uniform scramble keyed by the
+    // dimension's salt (owen_scramble on the index as a 32-bit integer: each bit flipped by a
+    // hash of the bits above it). Only the low 32 bits reach a 32-bit fraction, as in any
+    // 32-bit Sobol' generator; the index's bits above them (images of more than 2^32 samples)
+    // are hashed into the key, so that pixels far apart do not share points. pbrt-v4 permutes
+    // each base-4 digit by a 64-bit hash of the digits above it instead, which took twice the
+    // instructions here (path_glass's blocks: 104 M against 49 M), for the same error and blue
+    // noise (bench/RESULTS.md, "The index shuffle as a nested scramble").
+    constexpr void point_indices(std::uint64_t salt, std::array<std::uint32_t, lanes>& shuffled) const {
         const std::uint64_t first = (morton_ << log2_samples_) | std::uint64_t(block_ * lanes);
-        std::uint32_t block_digits = known.pixel_digits;
-        std::array<std::uint32_t, lanes> lane_digits{};
-        const int top = first_pixel_digit() - 1;
-        // Lanes are indexed in 32 bits (the index's low 32 bits are all that reach a point), so
-        // that each lane loop below is a few 8-lane vector instructions.
+        const std::uint64_t above = first >> 32;
+        const std::uint32_t key = std::uint32_t(above == 0 ? salt : mix_bits(salt ^ above));
         const std::uint32_t first_low = std::uint32_t(first);
-        for (int digit = top; digit >= lowest_base4_digit(); --digit) {
-            const int shift = digit_shift(digit);
-            if (shift >= lane_bits) {
-                const std::uint32_t permutation = digit == top ? known.top : permutation_above(first, shift, known.salt);
-                block_digits |= permuted_digit(first, shift, permutation);
-                continue;
-            }
-            // The permutations of the lanes: the digits above this one differ from lane to lane
-            // only in the lane bits above it (bits shift + 2 and up), so `variants` hashes, whose
-            // permutations' bytes are packed in one word; lane l takes byte l >> above by a shift
-            // of its own, where an array of bytes would be gathered lane by lane (GCC then left
-            // the loop scalar: 310 instructions a block at 16 samples).
-            const int above = shift + 2;
-            const std::uint32_t variants = above >= lane_bits ? 1 : std::uint32_t(1) << (lane_bits - above);
-            std::uint32_t packed = 0;
-            for (std::uint32_t v = 0; v < variants; ++v)
-                packed |= sampling::base4_permutation_byte(
-                              digit == top ? known.top : permutation_above(first | (std::uint64_t(v) << above), shift, known.salt))
-                          << (8 * v);
-            // Not unrolled: unrolled, its lanes were left as scalar code.
-#pragma GCC unroll 1
-            for (std::uint32_t l = 0; l < std::uint32_t(lanes); ++l) {
-                const std::uint32_t value = ((first_low | l) >> shift) & 3;
-                lane_digits[l] |= ((packed >> (8 * (l >> above) + 2 * value)) & 3) << shift;
-            }
-        }
-        if (log2_samples_ & 1) {
-            if (top >= lowest_base4_digit()) {
-                // The base-2 digit's flip hashes the lane's bits above bit 0: a bit for each pair
-                // of lanes.
-                std::uint32_t flips = 0;
-                for (std::uint32_t v = 0; v < std::uint32_t(lanes / 2); ++v)
-                    flips |= std::uint32_t(base2_flip(first | (std::uint64_t(v) << 1), known.salt)) << v;
-                for (std::uint32_t l = 0; l < std::uint32_t(lanes); ++l) lane_digits[l] |= (l & 1) ^ ((flips >> (l >> 1)) & 1);
-            } else {
-                for (std::uint32_t l = 0; l < std::uint32_t(lanes); ++l) lane_digits[l] |= ((first_low | l) & 1) ^ known.top;
-            }
-        }
-        for (std::size_t l = 0; l < lanes; ++l) shuffled[l] = block_digits | lane_digits[l];
-    }
-
-    // The lowest base-4 digit made of the pixel's bits alone (every digit below holds sample bits).
-    constexpr int first_pixel_digit() const { return (log2_samples_ + 1) / 2; }
-    // The lowest base-4 digit: 1 where an odd log2 of the sample count leaves a base-2 digit below.
-    constexpr int lowest_base4_digit() const { return log2_samples_ & 1; }
-    constexpr int digit_shift(int digit) const { return 2 * digit - (log2_samples_ & 1); }
-    // The base-2 digit's flip (odd log2 of the sample count): a hash bit of the digits above it.
-    static constexpr std::uint64_t base2_flip(std::uint64_t index, std::uint64_t salt) {
-        return mix_bits((index >> 1) ^ salt) >> 63;
-    }
-
-    // Which of the 24 permutations shuffles the base-4 digit at `shift` of `index`: a hash of the
-    // digits above it.
-    static constexpr std::uint32_t permutation_above(std::uint64_t index, int shift, std::uint64_t salt) {
-        const std::uint64_t above = shift + 2 >= 64 ? 0 : index >> (shift + 2);
-        return std::uint32_t(mix_bits(above ^ salt) >> 40) % 24;
-    }
-    static constexpr std::uint32_t permuted_digit(std::uint64_t index, int shift, std::uint32_t permutation) {
-        return sampling::permute_base4(permutation, std::uint32_t(index >> shift) & 3) << shift;
-    }
-
-    // Digits [first, last) of `index`, shuffled as every sample of its pixel shuffles them
-    // (each digit's hash depends on the digits above it, not on their shuffle); digits at or
-    // past bit 32 never reach a point.
-    // Only the digits that reach are hashed, one after another: a lane for each of 16 digits had
-    // AVX2 emulate 64-bit multiplications for every lane, reaching or not (images of up to 2^10
-    // pixels a side at 16 samples use 10).
-    constexpr std::uint32_t shuffled_digits(std::uint64_t index, int first, int last, std::uint64_t salt) const {
-        std::uint32_t digits = 0;
-        for (int digit = first; digit < last && digit_shift(digit) < 32; ++digit) {
-            const int shift = digit_shift(digit);
-            digits |= permuted_digit(index, shift, permutation_above(index, shift, salt));
-        }
-        return digits;
-    }
-
-    constexpr PixelDimension shared_by_samples(int dimension) const {
-        PixelDimension known;  // every member set below
-        const std::uint64_t index = morton_ << log2_samples_;
-        const std::uint64_t prefix = tables_ ? index >> tables_->prefix_shift : 0;
-        if (tables_ && std::uint32_t(dimension) < std::uint32_t(sampling::ZSobolTables::dimensions) &&
-            prefix < tables_->prefixes) {
-            const sampling::ZSobolTables::Keys& keyed = tables_->keys[std::size_t(dimension)];
-            known.salt = keyed.salt;
-            known.single_key = keyed.single;
-            known.pair_key = keyed.pair;
-            known.pixel_digits = tables_->top_digits[std::size_t(dimension) * tables_->prefixes + std::size_t(prefix)] |
-                                 shuffled_digits(index, first_pixel_digit(), tables_->first_digit, known.salt);
-        } else {
-            known.salt = sampling::dimension_key(keys_.salt, dimension);
-            known.single_key = std::uint32_t(sampling::dimension_key(keys_.single, dimension));
-            known.pair_key = sampling::dimension_key(keys_.pair, dimension);
-            known.pixel_digits = shuffled_digits(index, first_pixel_digit(), base4_digits_, known.salt);
-        }
-        known.top = 0;
-        const int top_digit = first_pixel_digit() - 1;
-        if (top_digit >= lowest_base4_digit()) known.top = std::uint8_t(permutation_above(index, digit_shift(top_digit), known.salt));
-        else if (log2_samples_ & 1) known.top = std::uint8_t(base2_flip(index, known.salt));
-        return known;
-    }
-
-    constexpr const PixelDimension& pixel_dimension() {
-        if (!cached()) {
-            uncached_ = shared_by_samples(dimension_);
-            return uncached_;
-        }
-        const std::uint64_t bit = std::uint64_t(1) << dimension_;
-        if (!(known_ & bit)) {
-            cache_[std::size_t(dimension_)] = shared_by_samples(dimension_);
-            known_ |= bit;
-        }
-        return cache_[std::size_t(dimension_)];
+        for (std::uint32_t l = 0; l < std::uint32_t(lanes); ++l) shuffled[l] = sampling::owen_scramble(first_low | l, key);
     }
 
     static constexpr int cached_dimensions = sampling::ZSobolTables::dimensions;
 
     std::uint64_t morton_;
-    int log2_samples_, base4_digits_;
+    int log2_samples_;
     sampling::ZSobolKeys keys_;
     const sampling::ZSobolTables* tables_;
     int dimension_ = 0;
     int lane_ = 0;
     std::uint32_t block_ = ~std::uint32_t(0);  // the block of samples whose points pairs_ and singles_ hold
-    std::uint64_t known_ = 0;          // bit d: cache_[d] holds dimension d's
     std::uint64_t pairs_known_ = 0;    // bit d: pairs_[d] holds the block's points of dimension d
     std::uint64_t singles_known_ = 0;  // bit d: singles_[d] holds them
-    std::array<PixelDimension, cached_dimensions> cache_;
-    PixelDimension uncached_;
     // Filled dimension by dimension as the block's first sample draws it (no values before).
     std::array<Pairs, cached_dimensions> pairs_;
     std::array<std::array<std::uint32_t, lanes>, cached_dimensions> singles_;
 };
 
 // A render's ZSobol pattern: its sample count rounded up to a power of two for the index (the
-// first samples_per_pixel of each pixel's block are used), and enough base-4 digits for the
-// larger side of the image rounded up to a power of two.
+// first samples_per_pixel of each pixel's block are used).
 class ZSobolPattern {
 public:
-    ZSobolPattern(int samples_per_pixel, int width, int height, std::uint64_t seed)
+    ZSobolPattern(int samples_per_pixel, int /*width*/, int /*height*/, std::uint64_t seed)
         : samples_per_pixel_(std::max(1, samples_per_pixel)), keys_(sampling::ZSobolKeys::of(seed)) {
         log2_samples_ = std::bit_width(std::uint32_t(samples_per_pixel_ - 1));
-        const int side = std::max({1, width, height});
-        const int log2_side = std::bit_width(std::uint32_t(side - 1));
-        base4_digits_ = log2_side + (log2_samples_ + 1) / 2;
-        tables_ = std::make_shared<const sampling::ZSobolTables>(ZSobolSampler::tables(keys_, log2_samples_, base4_digits_));
+        tables_ = std::make_shared<const sampling::ZSobolTables>(ZSobolSampler::tables(keys_));
     }
 
     // The pixel's sampler, which reads the pattern's tables: the pattern (or a copy of it)
     // outlives it, so a pattern about to end makes none (the sanitizers' build caught a test's
     // sampler drawing from its temporary pattern's freed tables).
     ZSobolSampler for_pixel(int x, int y) const& {
-        return ZSobolSampler(sampling::morton_2d(std::uint32_t(x), std::uint32_t(y)), log2_samples_, base4_digits_, keys_,
-                             tables_.get());
+        return ZSobolSampler(sampling::morton_2d(std::uint32_t(x), std::uint32_t(y)), log2_samples_, keys_, tables_.get());
     }
     ZSobolSampler for_pixel(int x, int y) const&& = delete;
     int samples_per_pixel() const { return samples_per_pixel_; }
@@ -500,7 +309,7 @@ public:
 private:
     int samples_per_pixel_;
     sampling::ZSobolKeys keys_;
-    int log2_samples_ = 0, base4_digits_ = 0;
+    int log2_samples_ = 0;
     std::shared_ptr<const sampling::ZSobolTables> tables_;  // shared by the pattern's copies
 };
 
