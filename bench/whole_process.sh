@@ -14,6 +14,12 @@
 #
 # Scenes: every distinct hw1/hw2 path of MANIFEST.tsv (default) and each --extra path (relative
 # to the course folder). Scenes either binary refuses are listed as such and skipped.
+#
+# Each vCPU is probed before and after every render (a fixed loop, as bench/paired.sh does): on
+# the 2-vCPU VMs a vCPU can run at less than half speed for seconds to minutes
+# (docs/benchmarks.md, "The machine"). A round is quiet when every probe around its renders ran
+# within 1.25 of that vCPU's fastest probe so far; the last two columns are the number of quiet
+# rounds and the median of new/old over them ("-" when none was).
 set -euo pipefail
 
 old=$1 new=$2
@@ -41,6 +47,38 @@ mapfile -t scenes < <(awk -F'\t' -v topics=",$topics," 'NR > 1 && index(topics, 
                         "$course/MANIFEST.tsv" | sort -u)
 scenes+=("${extras[@]}")
 
+# The probe: about 0.1 s of dependent multiply-adds on a vCPU at full speed.
+cat > "$work/probe.c" <<'PROBE'
+#include <stdio.h>
+#include <time.h>
+int main(void) {
+    struct timespec a, b;
+    clock_gettime(CLOCK_MONOTONIC, &a);
+    volatile unsigned long x = 0;
+    for (unsigned long i = 0; i < 300000000UL; ++i) x += i * i;
+    clock_gettime(CLOCK_MONOTONIC, &b);
+    printf("%.4f\n", (double)(b.tv_sec - a.tv_sec) + (double)(b.tv_nsec - a.tv_nsec) * 1e-9);
+    return 0;
+}
+PROBE
+probing=0
+if command -v cc > /dev/null && command -v taskset > /dev/null && cc -O1 -o "$work/probe" "$work/probe.c" 2> /dev/null; then
+  probing=1
+fi
+declare -A fastest
+quiet=1
+probe() {  # each vCPU's time for the loop; clears `quiet` when one ran slower than 1.25 of its fastest
+  ((probing)) || return 0
+  local cpu t
+  for ((cpu = 0; cpu < $(nproc); ++cpu)); do
+    t=$(taskset -c "$cpu" "$work/probe")
+    if [[ -z ${fastest[$cpu]:-} ]] || (($(echo "$t < ${fastest[$cpu]}" | bc -l))); then fastest[$cpu]=$t; fi
+    (($(echo "$t > 1.25 * ${fastest[$cpu]}" | bc -l))) && quiet=0
+  done
+  return 0
+}
+for _ in 1 2 3 4 5; do probe; done  # each vCPU's fastest, before the first round reads it
+
 now() { date +%s.%N; }
 run() {  # binary, output folder, scene, options...: prints seconds, or "refused"
   local binary=$1 out=$2 scene=$3
@@ -64,25 +102,32 @@ same_pixels() {
 median() { sort -g | awk '{ a[NR] = $1 } END { print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2 }'; }
 
 if [[ -n $base ]]; then
-  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' scene old_s new_s new/old same_images base_s new/base same_as_base
+  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' scene old_s new_s new/old same_images base_s new/base same_as_base \
+    quiet_rounds quiet_new/old
 else
-  printf '%s\t%s\t%s\t%s\t%s\n' scene old_s new_s new/old same_images
+  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\n' scene old_s new_s new/old same_images quiet_rounds quiet_new/old
 fi
 for scene in "${scenes[@]}"; do
-  old_times=() new_times=() ratios=() base_times=() base_ratios=() refused=
+  old_times=() new_times=() ratios=() base_times=() base_ratios=() refused= quiet_ratios=()
   for ((round = 0; round < rounds; ++round)); do
     t_base=0
+    quiet=1
+    probe
     if ((round % 2 == 0)); then
       t_old=$(run "$old" "$work/old" "$scene")
-      [[ -n $base ]] && t_base=$(run "$base" "$work/base" "$scene")
+      probe
+      [[ -n $base ]] && t_base=$(run "$base" "$work/base" "$scene") && probe
       t_new=$(run "$new" "$work/new" "$scene" "${new_options[@]}")
     else
       t_new=$(run "$new" "$work/new" "$scene" "${new_options[@]}")
-      [[ -n $base ]] && t_base=$(run "$base" "$work/base" "$scene")
+      probe
+      [[ -n $base ]] && t_base=$(run "$base" "$work/base" "$scene") && probe
       t_old=$(run "$old" "$work/old" "$scene")
     fi
+    probe
     if [[ $t_old == refused || $t_new == refused || $t_base == refused ]]; then refused=yes; break; fi
     old_times+=("$t_old") new_times+=("$t_new") ratios+=("$(echo "$t_new / $t_old" | bc -l)")
+    ((quiet && probing)) && quiet_ratios+=("$(echo "$t_new / $t_old" | bc -l)")
     if [[ -n $base ]]; then base_times+=("$t_base") base_ratios+=("$(echo "$t_new / $t_base" | bc -l)"); fi
   done
   if [[ -n $refused ]]; then
@@ -104,5 +149,9 @@ for scene in "${scenes[@]}"; do
     printf '\t%.3f\t%.3f\t%s' "$(printf '%s\n' "${base_times[@]}" | median)" \
       "$(printf '%s\n' "${base_ratios[@]}" | median)" "$same_base"
   fi
-  printf '\n'
+  if ((${#quiet_ratios[@]})); then
+    printf '\t%d\t%.3f\n' "${#quiet_ratios[@]}" "$(printf '%s\n' "${quiet_ratios[@]}" | median)"
+  else
+    printf '\t0\t-\n'
+  fi
 done
