@@ -18,13 +18,15 @@
 # The machine's vCPUs are probed around every render: a fixed loop timed on each vCPU the render
 # may use. On the 2-vCPU VMs a vCPU runs the same loop 2.2 times slower for seconds to minutes at
 # a time, each vCPU on its own (docs/benchmarks.md, "The machine"), so a render is "quiet" when
-# every probe before and after it ran within 1.25 of that vCPU's fastest probe of the run. The
-# last line gives each binary's ratios over the rounds in which both it and the first binary
-# rendered quietly. --cpu N pins every render (and the probes) to vCPU N, for one-thread runs.
+# every probe before and after it ran within 1.25 of the fastest probe of the run on any vCPU
+# (the vCPUs are alike: measured against its own fastest, a vCPU slow for the whole run would
+# count as quiet). The last line gives each binary's ratios over the rounds in which both it
+# and the first binary rendered quietly. --cpu N pins every render (and the probes) to vCPU N,
+# for one-thread runs.
 set -euo pipefail
 
 if [[ $# -lt 3 ]]; then
-  sed -n '2,22p' "$0" >&2
+  sed -n '2,24p' "$0" >&2
   exit 2
 fi
 rounds=$1 scene=$2
@@ -132,7 +134,8 @@ for k, label in enumerate(labels):
         line += f", wall {spread([wall[(r, k)] / wall[(r, 0)] for r in rounds if wall[(r, 0)] > 0])}"
         line += "  same images" if k not in differing else f"  OTHER IMAGES in {differing[k]} of {len(rounds)} rounds"
     print(line)
-# The probes: a render is quiet when every probe around it ran within 1.25 of its vCPU's fastest.
+# The probes: a render is quiet when every probe around it ran within 1.25 of the fastest probe
+# on any vCPU (full speed).
 probe_times = {}
 for line in open(probes):
     r, k, _, cpu, t = line.split()
@@ -142,10 +145,11 @@ if probe_times:
     for values in probe_times.values():
         for cpu, t in values:
             fastest[cpu] = min(fastest.get(cpu, t), t)
-    quiet = {key for key, values in probe_times.items() if all(t <= 1.25 * fastest[cpu] for cpu, t in values)}
-    slowest = max(t / fastest[cpu] for values in probe_times.values() for cpu, t in values)
+    full_speed = min(fastest.values())
+    quiet = {key for key, values in probe_times.items() if all(t <= 1.25 * full_speed for _, t in values)}
+    slowest = max(t for values in probe_times.values() for _, t in values) / full_speed
     summary = ", ".join(f"vCPU {cpu} {fastest[cpu]:.3f} s" for cpu in sorted(fastest))
-    print(f"probes: fastest {summary}; the slowest probe {slowest:.2f} times its vCPU's fastest; "
+    print(f"probes: fastest {summary}; the slowest probe {slowest:.2f} times the fastest; "
           f"{len(quiet)} of {len(probe_times)} renders quiet")
     for k, label in enumerate(labels[1:], 1):
         both = [r for r in rounds if (r, 0) in quiet and (r, k) in quiet]

@@ -18,8 +18,9 @@
 # Each vCPU is probed before and after every render (a fixed loop, as bench/paired.sh does): on
 # the 2-vCPU VMs a vCPU can run at less than half speed for seconds to minutes
 # (docs/benchmarks.md, "The machine"). A round is quiet when every probe around its renders ran
-# within 1.25 of that vCPU's fastest probe so far; the last two columns are the number of quiet
-# rounds and the median of new/old over them ("-" when none was).
+# within 1.25 of the fastest probe so far on any vCPU (the vCPUs are alike: measured against its
+# own fastest, a vCPU slow since the start would count as quiet); the last two columns are the
+# number of quiet rounds and the median of new/old over them ("-" when none was).
 set -euo pipefail
 
 old=$1 new=$2
@@ -65,19 +66,21 @@ probing=0
 if command -v cc > /dev/null && command -v taskset > /dev/null && cc -O1 -o "$work/probe" "$work/probe.c" 2> /dev/null; then
   probing=1
 fi
-declare -A fastest
+fastest=
+declare -A fastest_on  # each vCPU's own fastest, for the summary line
 quiet=1
-probe() {  # each vCPU's time for the loop; clears `quiet` when one ran slower than 1.25 of its fastest
+probe() {  # each vCPU's time for the loop; clears `quiet` when one ran slower than 1.25 of the fastest
   ((probing)) || return 0
   local cpu t
   for ((cpu = 0; cpu < $(nproc); ++cpu)); do
     t=$(taskset -c "$cpu" "$work/probe")
-    if [[ -z ${fastest[$cpu]:-} ]] || (($(echo "$t < ${fastest[$cpu]}" | bc -l))); then fastest[$cpu]=$t; fi
-    (($(echo "$t > 1.25 * ${fastest[$cpu]}" | bc -l))) && quiet=0
+    if [[ -z $fastest ]] || (($(echo "$t < $fastest" | bc -l))); then fastest=$t; fi
+    if [[ -z ${fastest_on[$cpu]:-} ]] || (($(echo "$t < ${fastest_on[$cpu]}" | bc -l))); then fastest_on[$cpu]=$t; fi
+    (($(echo "$t > 1.25 * $fastest" | bc -l))) && quiet=0
   done
   return 0
 }
-for _ in 1 2 3 4 5; do probe; done  # each vCPU's fastest, before the first round reads it
+for _ in 1 2 3 4 5; do probe; done  # the fastest, before the first round reads it
 
 now() { date +%s.%N; }
 run() {  # binary, output folder, scene, options...: prints seconds, or "refused"
@@ -155,3 +158,8 @@ for scene in "${scenes[@]}"; do
     printf '\t0\t-\n'
   fi
 done
+if ((probing)); then
+  summary=
+  for ((cpu = 0; cpu < $(nproc); ++cpu)); do summary+=" vCPU $cpu ${fastest_on[$cpu]} s"; done
+  echo "probes: the fastest of each:$summary (quiet: within 1.25 of the fastest)" >&2
+fi
