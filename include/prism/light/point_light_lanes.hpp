@@ -46,7 +46,7 @@ std::uint32_t point_light_lanes(const PointLight<Real>& light, const ShadingRow<
     // hw2 mirror_room took 1.08, 1.06 and 1.06 times as long on the Intel VM, the same images.
     // Why is not settled: neither two 256-bit divisions for each 512-bit one nor the
     // double-refine packets in 256-bit halves changed anything elsewhere (bench/RESULTS.md,
-    // "Stalls and draws nobody reads").
+    // "Whole renders").
     constexpr int width = int(32 / sizeof(Real));
     static_assert(int(RowWidth) % width == 0);
     using Lanes = simd::Pack<Real, width>;
