@@ -21,7 +21,7 @@
 // ends where it went on carrying next to nothing; with the independent sampler the pixel's later
 // samples then draw other numbers. So five of hw7 path_glass's nine images differ, in 1 to 289 of
 // their 16,384 pixels at a quarter scale and 16 samples, within the noise (bench/RESULTS.md,
-// "Sobol's cost a sample"). The consumer's own code is not affected: the bits are restored when
+// "Subnormal fourth lanes"). The consumer's own code is not affected: the bits are restored when
 // the scope ends, and the Renderer ends it before calling back into the consumer (on_tile).
 #pragma once
 

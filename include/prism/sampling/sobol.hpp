@@ -262,7 +262,7 @@ private:
     // are hashed into the key, so that pixels far apart do not share points. pbrt-v4 permutes
     // each base-4 digit by a 64-bit hash of the digits above it instead, which took twice the
     // instructions here (path_glass's blocks: 104 M against 49 M), for the same error and blue
-    // noise (bench/RESULTS.md, "The index shuffle as a nested scramble").
+    // noise (bench/RESULTS.md, "How sobol works", "Sobol's cost a sample").
     constexpr void point_indices(std::uint64_t salt, std::array<std::uint32_t, lanes>& shuffled) const {
         const std::uint64_t first = (morton_ << log2_samples_) | std::uint64_t(block_ * lanes);
         const std::uint64_t above = first >> 32;
