@@ -18,6 +18,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
+#include <type_traits>
 
 #ifndef PRISM_SHARED_DIR
 #define PRISM_SHARED_DIR "../shared"
@@ -47,10 +48,17 @@ const scene::Scene& course_scene() {
     return loaded;
 }
 
+// The two ray tracers `prism` ships for each precision (render/render_scene.hpp, ShippedConfigs):
+// the same acceleration structure and sampler policy, the fitted light set and features or all.
 template <class Real>
-using Fitted = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::PointLightSet, prism::no_features>;
+using Acceleration = typename prism::PrecisionPolicy<std::is_same_v<Real, float> ? prism::Precision::single
+                                                                                 : prism::Precision::double_all>::Acceleration;
 template <class Real>
-using Complete = prism::Config<Real, prism::Bvh<prism::Watertight>, prism::AllLightSet, prism::all_features>;
+using Fitted = prism::Config<Real, Acceleration<Real>, prism::PointLightSet, prism::no_features, prism::Whitted,
+                             prism::ChosenPattern>;
+template <class Real>
+using Complete = prism::Config<Real, Acceleration<Real>, prism::AllLightSet, prism::all_features, prism::Whitted,
+                               prism::ChosenPattern>;
 
 // Both renderers must produce the same image, bit for bit: the complete one only carries code
 // the scene does not use.
