@@ -67,7 +67,10 @@ double seconds_since(Clock::time_point start) { return std::chrono::duration<dou
 // Renders a camera at a size; one per variant and scene, built (BVH included) before timing.
 using RenderFunction = std::function<prism::Image(const prism::scene::Camera&, int width, int height)>;
 
-template <class Real, class Intersector, class Acceleration = prism::Bvh<Intersector>>
+// prism's own variants traverse the structure the shipped renderers build (render_scene.hpp's
+// PrecisionPolicy): the wide BVH of this instruction set's width, its leaves' packets of the
+// variant's triangle test.
+template <class Real, class Intersector, class Acceleration = prism::WideBvh<Intersector, prism::wide_bvh_width>>
 RenderFunction build_renderer(const prism::scene::Scene& scene, prism::RayOffset offset) {
     using Config = prism::Config<Real, Acceleration, prism::Lights<prism::PointLight>>;
     auto renderer = std::make_shared<const prism::Renderer<Config>>(scene, prism::RendererSettings{prism::BackfaceCulling::none, offset, 0, {}});

@@ -64,14 +64,23 @@ inline std::string lowercase_extension(const std::filesystem::path& path) {
 // file system (and is therefore atomic). Process id and a counter keep concurrent writers apart.
 inline std::filesystem::path temporary_sibling(const std::filesystem::path& path) {
     static std::atomic<unsigned> counter{0};
-    const std::string suffix = "." + std::to_string(::getpid()) + "." + std::to_string(counter++) + ".tmp";
+    // Appended piece by piece: GCC 12 warns falsely (-Wrestrict, GCC bug 105651) on a literal
+    // prepended to a temporary string where it inlines the insertion.
+    std::string suffix = ".";
+    suffix += std::to_string(::getpid());
+    suffix += '.';
+    suffix += std::to_string(counter++);
+    suffix += ".tmp";
     // The name is cut from its start where the whole would pass a file name's NAME_MAX bytes: an
     // image name of 250 bytes is allowed (io::confined_output_path), and its temporary file
     // must be too.
     std::string name = path.filename().string();
     if (1 + name.size() + suffix.size() > NAME_MAX) name.erase(0, 1 + name.size() + suffix.size() - NAME_MAX);
     std::filesystem::path temporary = path;
-    temporary.replace_filename("." + name + suffix);
+    std::string hidden = ".";
+    hidden += name;
+    hidden += suffix;
+    temporary.replace_filename(hidden);
     return temporary;
 }
 
