@@ -14,6 +14,7 @@
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -102,10 +103,12 @@ void BM_AreaLightSample(benchmark::State& state) {
         const prism::LightSample<Real> sample = light.sample(at, random.uniform2<Real>());
         sum += double(sample.radiance.r);
     }
-    // The estimates average to the panel's irradiance, 10 * integral cos/d^2 dA ~ 3.5: a check
-    // that the work was done and done right.
+    // The estimates average to 10 * integral cos_light / d^2 dA over the panel, 3.9805 (midpoint
+    // quadrature on a 2000 x 2000 grid; measured 3.9805 in float and double): a check that the
+    // work was done and done right, within 1% (over 100,000 samples the mean's standard error is
+    // about 0.002).
     const double mean = sum / double(state.iterations());
-    if (state.iterations() > 100000 && !(mean > 3.0 && mean < 4.0)) state.SkipWithError("area light estimate is off");
+    if (state.iterations() > 100000 && !(std::abs(mean - 3.9805) < 0.04)) state.SkipWithError("area light estimate is off");
     state.counters["mean"] = mean;
 }
 
